@@ -1,0 +1,1 @@
+"""Assets: resolving URDF/mesh URIs and reading URDF structure (no simulator imports)."""

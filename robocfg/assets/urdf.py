@@ -1,0 +1,268 @@
+"""A light URDF reader (xml.etree): links, joints, limits, mimic tags, geometry, inertials.
+
+Fast enough for ``robocfg validate`` (no trimesh, no simulator). DOF indices follow the order of
+movable joints in the file, the same order PyBullet uses for its joint indices.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+MOVABLE = ("revolute", "continuous", "prismatic")
+
+
+class UrdfParseError(Exception):
+    """The URDF could not be parsed; ``line`` is set when known."""
+
+    def __init__(self, message: str, line: int | None = None):
+        self.line = line
+        super().__init__(message)
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """One visual/collision geometry: ``kind`` box|sphere|cylinder|capsule|mesh, origin in the link frame."""
+
+    kind: str
+    origin: np.ndarray  # 4x4, link frame
+    size: tuple[float, ...] = ()
+    filename: str | None = None
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Link:
+    name: str
+    mass: float | None
+    visuals: tuple[Geometry, ...]
+    collisions: tuple[Geometry, ...]
+
+
+@dataclass(frozen=True)
+class Mimic:
+    joint: str
+    multiplier: float = 1.0
+    offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: np.ndarray  # 4x4, parent link frame → joint frame
+    axis: np.ndarray  # unit 3-vector in the joint frame
+    lower: float
+    upper: float
+    effort: float
+    velocity: float
+    mimic: Mimic | None
+    urdf_index: int  # position among all joints (PyBullet joint index)
+
+    @property
+    def movable(self) -> bool:
+        return self.type in MOVABLE
+
+
+@dataclass
+class Urdf:
+    """Parsed URDF."""
+
+    path: Path
+    name: str
+    links: dict[str, Link]
+    joints: dict[str, Joint]
+    root: str
+    dof_joints: list[str] = field(default_factory=list)
+
+    def dof_index(self, joint: str) -> int:
+        return self.dof_joints.index(joint)
+
+    def joint_to_child(self, link: str) -> Joint | None:
+        for j in self.joints.values():
+            if j.child == link:
+                return j
+        return None
+
+    def chain(self, base: str, tip: str) -> list[Joint] | None:
+        """Joints from ``base`` down to ``tip`` (all types), or None if tip is not below base."""
+        out: list[Joint] = []
+        cur = tip
+        while cur != base:
+            j = self.joint_to_child(cur)
+            if j is None:
+                return None
+            out.append(j)
+            cur = j.parent
+        return out[::-1]
+
+    def link_pose(self, link: str, q: dict[str, float] | None = None) -> np.ndarray:
+        """4x4 pose of ``link`` in the root link frame for joint positions ``q`` (missing → 0;
+        mimic followers follow their leader)."""
+        q = dict(q or {})
+        T = np.eye(4)
+        for j in self.chain(self.root, link) or []:
+            T = T @ j.origin @ joint_motion(j, self.joint_value(j, q))
+        return T
+
+    def joint_value(self, j: Joint, q: dict[str, float]) -> float:
+        if j.mimic is not None and j.name not in q:
+            return j.mimic.multiplier * q.get(j.mimic.joint, 0.0) + j.mimic.offset
+        return q.get(j.name, 0.0)
+
+    def descendants(self, joint: str) -> set[str]:
+        """Links moved by ``joint``."""
+        start = self.joints[joint].child
+        out, stack = {start}, [start]
+        while stack:
+            cur = stack.pop()
+            for j in self.joints.values():
+                if j.parent == cur and j.child not in out:
+                    out.add(j.child)
+                    stack.append(j.child)
+        return out
+
+
+def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
+    a = axis / np.linalg.norm(axis)
+    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def joint_motion(j: Joint, value: float) -> np.ndarray:
+    T = np.eye(4)
+    if j.type in ("revolute", "continuous"):
+        T[:3, :3] = axis_angle(j.axis, value)
+    elif j.type == "prismatic":
+        T[:3, 3] = j.axis * value
+    return T
+
+
+def _floats(text: str | None, n: int, default: float = 0.0) -> tuple[float, ...]:
+    if not text:
+        return (default,) * n
+    vals = [float(v) for v in text.split()]
+    if len(vals) != n:
+        raise ValueError(f"expected {n} numbers, got {text!r}")
+    return tuple(vals)
+
+
+def _origin(el: ET.Element | None) -> np.ndarray:
+    T = np.eye(4)
+    if el is None:
+        return T
+    T[:3, 3] = _floats(el.get("xyz"), 3)
+    T[:3, :3] = rpy_matrix(*_floats(el.get("rpy"), 3))
+    return T
+
+
+def _geometry(el: ET.Element) -> Geometry | None:
+    g = el.find("geometry")
+    if g is None or len(g) == 0:
+        return None
+    shape = g[0]
+    origin = _origin(el.find("origin"))
+    if shape.tag == "mesh":
+        scale = _floats(shape.get("scale"), 3, 1.0) if shape.get("scale") else (1.0, 1.0, 1.0)
+        return Geometry("mesh", origin, filename=shape.get("filename", ""), scale=scale)  # type: ignore[arg-type]
+    if shape.tag == "box":
+        return Geometry("box", origin, size=_floats(shape.get("size"), 3))
+    if shape.tag == "sphere":
+        return Geometry("sphere", origin, size=(float(shape.get("radius", 0)),))
+    if shape.tag in ("cylinder", "capsule"):
+        return Geometry(shape.tag, origin, size=(float(shape.get("radius", 0)), float(shape.get("length", 0))))
+    return None
+
+
+def parse_urdf(path: Path) -> Urdf:
+    """Parse a URDF file. Raises UrdfParseError with a line number when the XML is broken."""
+    try:
+        tree = ET.parse(path)
+    except ET.ParseError as exc:
+        raise UrdfParseError(f"broken XML: {exc}", exc.position[0] if exc.position else None) from None
+    except OSError as exc:
+        raise UrdfParseError(f"cannot read: {exc}") from None
+    root = tree.getroot()
+    if root.tag != "robot":
+        raise UrdfParseError(f"top element is <{root.tag}>, expected <robot>", 1)
+    try:
+        links: dict[str, Link] = {}
+        for el in root.findall("link"):
+            inertial = el.find("inertial")
+            mass = None
+            if inertial is not None and inertial.find("mass") is not None:
+                mass = float(inertial.find("mass").get("value", 0))  # type: ignore[union-attr]
+            vis = tuple(g for g in (_geometry(v) for v in el.findall("visual")) if g)
+            col = tuple(g for g in (_geometry(c) for c in el.findall("collision")) if g)
+            links[el.get("name", "")] = Link(el.get("name", ""), mass, vis, col)
+        joints: dict[str, Joint] = {}
+        for i, el in enumerate(root.findall("joint")):
+            jtype = el.get("type", "fixed")
+            limit = el.find("limit")
+            lower = float(limit.get("lower", 0)) if limit is not None else 0.0
+            upper = float(limit.get("upper", 0)) if limit is not None else 0.0
+            if jtype == "continuous":
+                lower, upper = -np.pi, np.pi
+            mimic_el = el.find("mimic")
+            mimic = None
+            if mimic_el is not None:
+                mimic = Mimic(mimic_el.get("joint", ""), float(mimic_el.get("multiplier", 1)), float(mimic_el.get("offset", 0)))
+            axis_el = el.find("axis")
+            axis = np.array(_floats(axis_el.get("xyz") if axis_el is not None else None, 3)) if axis_el is not None else np.array([1.0, 0, 0])
+            if jtype in MOVABLE and np.linalg.norm(axis) > 0:
+                axis = axis / np.linalg.norm(axis)
+            parent, child = el.find("parent"), el.find("child")
+            joints[el.get("name", "")] = Joint(
+                name=el.get("name", ""),
+                type=jtype,
+                parent=parent.get("link", "") if parent is not None else "",
+                child=child.get("link", "") if child is not None else "",
+                origin=_origin(el.find("origin")),
+                axis=axis,
+                lower=lower,
+                upper=upper,
+                effort=float(limit.get("effort", 0)) if limit is not None else 0.0,
+                velocity=float(limit.get("velocity", 0)) if limit is not None else 0.0,
+                mimic=mimic,
+                urdf_index=i,
+            )
+    except (ValueError, TypeError) as exc:
+        raise UrdfParseError(f"bad value: {exc}") from None
+    children = {j.child for j in joints.values()}
+    roots = [n for n in links if n not in children]
+    if len(roots) != 1:
+        raise UrdfParseError(f"expected one root link, found {roots or 'none'}")
+    order = _depth_first(roots[0], list(joints.values()))
+    joints = {j.name: replace(j, urdf_index=i) for i, j in enumerate(order)}
+    dof = [j.name for j in order if j.movable]
+    return Urdf(path, root.get("name", ""), links, joints, roots[0], dof)
+
+
+def _depth_first(root: str, joints: list[Joint]) -> list[Joint]:
+    """Joints in PyBullet's index order: depth-first from the root, children in file order."""
+    out: list[Joint] = []
+
+    def visit(link: str) -> None:
+        for j in joints:
+            if j.parent == link:
+                out.append(j)
+                visit(j.child)
+
+    visit(root)
+    return out

@@ -1,0 +1,265 @@
+"""Load a robot YAML, validate its schema, and cross-check it against its URDF.
+
+Errors stop the robot from being used; warnings are reported (``--strict`` makes them errors).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robocfg.assets.meshes import geometry_points
+from robocfg.assets.paths import Resolver, UnresolvedPath
+from robocfg.assets.urdf import Urdf, UrdfParseError, parse_urdf
+from robocfg.config.load import Loc, YamlDocument, load_yaml, validate_document
+from robocfg.config.robot import ArmConfig, ParallelGripperConfig, RobotConfig, SuctionGripperConfig
+from robocfg.config.suggest import did_you_mean
+from robocfg.config.types import AXIS_INDEX
+from robocfg.errors import ConfigError, Problem
+
+ROT_TOL = 1e-6
+TCP_WARN_DIST = 0.010  # m
+TCP_WARN_ANGLE_DEG = 10.0
+PAD_LENGTH = 0.02  # m: the distal part of a finger counted as its pad
+
+
+@dataclass
+class CheckedRobot:
+    """A robot YAML that passed its checks, with the parsed URDF and the resolved arm joints."""
+
+    config: RobotConfig
+    doc: YamlDocument
+    urdf_path: Path
+    urdf: Urdf
+    warnings: list[Problem] = field(default_factory=list)
+
+    @property
+    def path(self) -> Path:
+        return self.doc.path
+
+    def arm_joints(self, arm: ArmConfig) -> list[str]:
+        """Arm joint names (from names, or from DOF indices)."""
+        if arm.joints is not None:
+            return list(arm.joints)
+        return [self.urdf.dof_joints[i] for i in arm.joint_indices or []]
+
+    def gripper_joints(self, arm: ArmConfig) -> list[str]:
+        g = arm.gripper
+        if not isinstance(g, ParallelGripperConfig):
+            return []
+        if g.joints is not None:
+            return list(g.joints)
+        return [self.urdf.dof_joints[i] for i in g.gripper_indices or []]
+
+    def mimic_followers(self, leaders: list[str]) -> list[str]:
+        return [j.name for j in self.urdf.joints.values() if j.mimic is not None and j.mimic.joint in leaders]
+
+
+class _Collector:
+    def __init__(self, doc: YamlDocument):
+        self.doc, self.problems = doc, []
+
+    def error(self, loc: Loc, msg: str) -> None:
+        self.problems.append(self.doc.problem(loc, msg))
+
+    def warn(self, loc: Loc, msg: str) -> None:
+        self.problems.append(self.doc.problem(loc, msg, "warning"))
+
+
+def load_robot(path: str | Path, strict: bool = False) -> CheckedRobot:
+    """Load and check a robot YAML. Raises ConfigError listing every error (and, if strict, warning)."""
+    doc = load_yaml(path)
+    config: RobotConfig = validate_document(doc, RobotConfig)
+    c = _Collector(doc)
+    resolver = Resolver(doc.path.parent, config.package_dirs)
+    try:
+        urdf_path = resolver.urdf(config.urdf)
+    except UnresolvedPath as exc:
+        raise ConfigError([doc.problem(("urdf",), f"URDF not found: {exc}")]) from None
+    try:
+        urdf = parse_urdf(urdf_path)
+    except UrdfParseError as exc:
+        line = f":{exc.line}" if exc.line else ""
+        raise ConfigError([doc.problem(("urdf",), f"URDF {urdf_path}{line} does not parse: {exc}")]) from None
+    robot = CheckedRobot(config, doc, urdf_path, urdf)
+    _check_meshes(c, robot, resolver)
+    for i, arm in enumerate(config.arms):
+        _check_arm(c, robot, arm, ("arms", i), resolver)
+    _check_drives_and_physics(c, robot)
+    errors = [p for p in c.problems if p.severity == "error"]
+    warnings = [p for p in c.problems if p.severity == "warning"]
+    if errors or (strict and warnings):
+        raise ConfigError(errors + (warnings if strict else []))
+    robot.warnings = warnings
+    return robot
+
+
+def _check_meshes(c: _Collector, robot: CheckedRobot, resolver: Resolver) -> None:
+    for link in robot.urdf.links.values():
+        for g in (*link.visuals, *link.collisions):
+            if g.kind != "mesh" or not g.filename:
+                continue
+            try:
+                resolver.mesh(g.filename, robot.urdf_path)
+            except UnresolvedPath as exc:
+                tried = ", ".join(str(t) for t in exc.tried)
+                c.error(("urdf",), f"mesh {g.filename!r} of link {link.name!r} not found; tried: {tried}")
+
+
+def _known(c: _Collector, loc: Loc, name: str, names: list[str], kind: str) -> bool:
+    if name in names:
+        return True
+    c.error(loc, f"no {kind} {name!r} in the URDF{did_you_mean(name, names)}")
+    return False
+
+
+def _check_arm(c: _Collector, robot: CheckedRobot, arm: ArmConfig, loc: Loc, resolver: Resolver) -> None:
+    urdf = robot.urdf
+    links = list(urdf.links)
+    ok_links = _known(c, (*loc, "base_link"), arm.base_link, links, "link")
+    ok_links &= _known(c, (*loc, "ee_link"), arm.ee_link, links, "link")
+    names_ok = _check_joint_list(c, urdf, arm.joints, arm.joint_indices, loc, "joints", "joint_indices")
+    if not names_ok:
+        return
+    arm_joints = robot.arm_joints(arm)
+    if ok_links:
+        chain = urdf.chain(arm.base_link, arm.ee_link)
+        if chain is None:
+            c.error((*loc, "ee_link"), f"ee_link {arm.ee_link!r} is not below base_link {arm.base_link!r} in the URDF tree")
+        else:
+            movable = [j.name for j in chain if j.movable]
+            if movable != arm_joints:
+                c.error((*loc, "joints" if arm.joints else "joint_indices"),
+                        f"arm joints must be the movable joints from base_link to ee_link in order: {movable}, got {arm_joints}")
+    # R_ee_graspnet
+    R = np.asarray(arm.R_ee_graspnet, dtype=float)
+    if not np.allclose(R @ R.T, np.eye(3), atol=ROT_TOL) or abs(np.linalg.det(R) - 1) > ROT_TOL:
+        c.error((*loc, "R_ee_graspnet"), f"must be a rotation (orthonormal, det +1); R·Rᵀ deviates by {np.abs(R @ R.T - np.eye(3)).max():.2e}, det = {np.linalg.det(R):.4f}")
+    else:
+        col = R[:, AXIS_INDEX[arm.ee_axis]]
+        if not np.allclose(col, [1, 0, 0], atol=ROT_TOL):
+            c.error((*loc, "R_ee_graspnet"),
+                    f"column {AXIS_INDEX[arm.ee_axis]} (ee_axis '{arm.ee_axis}') must be (1, 0, 0): the EE approach axis is the grasp frame's x; got {np.round(col, 6).tolist()}")
+    # home within limits
+    for k, (jn, q) in enumerate(zip(arm_joints, arm.home, strict=True)):
+        j = urdf.joints[jn]
+        if j.type == "continuous":
+            continue
+        if not (j.lower - 1e-9 <= q <= j.upper + 1e-9):
+            c.error((*loc, "home", k), f"home of {jn} = {q:.4f} is outside the limits [{j.lower:.4f}, {j.upper:.4f}]")
+        elif arm.home_std is not None:
+            s = 3 * arm.home_std[k]
+            if q - s < j.lower or q + s > j.upper:
+                c.warn((*loc, "home_std", k), f"home ± 3·std for {jn} ({q - s:.3f}..{q + s:.3f}) leaves the limits [{j.lower:.3f}, {j.upper:.3f}]")
+    for key in ("ignore_links", "forbid_links"):
+        for k, ln in enumerate(getattr(arm.collision_filter, key)):
+            _known(c, (*loc, "collision_filter", key, k), ln, links, "link")
+    g = arm.gripper
+    if isinstance(g, ParallelGripperConfig):
+        _check_parallel(c, robot, arm, g, (*loc, "gripper"), resolver)
+    elif isinstance(g, SuctionGripperConfig) and _known(c, (*loc, "gripper", "link"), g.link, links, "link"):
+        chain = urdf.chain(arm.ee_link, g.link) if arm.ee_link in links else []
+        if chain is None or any(j.movable for j in chain):
+            c.error((*loc, "gripper", "link"), f"suction link {g.link!r} must be rigidly attached below ee_link {arm.ee_link!r}")
+
+
+def _check_joint_list(c: _Collector, urdf: Urdf, names: list[str] | None, indices: list[int] | None,
+                      loc: Loc, name_key: str, index_key: str) -> bool:
+    ok = True
+    joints = list(urdf.joints)
+    if names is not None:
+        for k, n in enumerate(names):
+            if not _known(c, (*loc, name_key, k), n, joints, "joint"):
+                ok = False
+            elif not urdf.joints[n].movable:
+                c.error((*loc, name_key, k), f"joint {n!r} is {urdf.joints[n].type}, not movable")
+                ok = False
+    if indices is not None:
+        ndof = len(urdf.dof_joints)
+        for k, i in enumerate(indices):
+            if not 0 <= i < ndof:
+                fixed = [j.name for j in urdf.joints.values() if not j.movable]
+                c.error((*loc, index_key, k), f"DOF index {i} is out of range: the URDF has {ndof} movable joints (0..{ndof - 1}); fixed joints such as {fixed[:3]} have no DOF index")
+                ok = False
+            elif names is not None and k < len(names) and urdf.dof_joints[i] != names[k]:
+                c.error((*loc, index_key, k), f"DOF index {i} is {urdf.dof_joints[i]!r} but {name_key}[{k}] is {names[k]!r}")
+                ok = False
+    return ok
+
+
+def _check_parallel(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGripperConfig,
+                    loc: Loc, resolver: Resolver) -> None:
+    urdf = robot.urdf
+    if not _check_joint_list(c, urdf, g.joints, g.gripper_indices, loc, "joints", "gripper_indices"):
+        return
+    leaders = robot.gripper_joints(arm)
+    arm_joints = set(robot.arm_joints(arm)) if (arm.joints or arm.joint_indices) else set()
+    for k, jn in enumerate(leaders):
+        j = urdf.joints[jn]
+        if jn in arm_joints:
+            c.error((*loc, "joints", k), f"gripper joint {jn!r} is also an arm joint")
+        if arm.ee_link in urdf.descendants(jn):
+            c.error((*loc, "joints", k), f"gripper joint {jn!r} moves ee_link {arm.ee_link!r}: the EE→TCP transform must be fixed; pick a link above the fingers")
+        for key in ("open", "closed"):
+            v = getattr(g, key)[k]
+            if not (j.lower - 1e-9 <= v <= j.upper + 1e-9):
+                c.error((*loc, key, k), f"{key} position {v} of {jn} is outside the limits [{j.lower}, {j.upper}]")
+    finger_ok = all(_known(c, (*loc, "finger_links", k), f, list(urdf.links), "link") for k, f in enumerate(g.finger_links))
+    if finger_ok and arm.ee_link in urdf.links:
+        _check_tcp(c, robot, arm, g, leaders, loc, resolver)
+
+
+def _check_tcp(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGripperConfig,
+               leaders: list[str], loc: Loc, resolver: Resolver) -> None:
+    """The finger-pad midpoint (gripper open, by FK) must lie along +ee_axis at ≈ tcp_offset."""
+    urdf = robot.urdf
+    q = dict(zip(leaders, g.open, strict=True))
+    T_ee_inv = np.linalg.inv(urdf.link_pose(arm.ee_link, q))
+    axis = AXIS_INDEX[arm.ee_axis]
+    pads = []
+    for fl in g.finger_links:
+        link = urdf.links[fl]
+        geoms = link.collisions or link.visuals
+        pts = []
+        for geom in geoms:
+            mesh = None
+            if geom.kind == "mesh":
+                try:
+                    mesh = resolver.mesh(geom.filename or "", robot.urdf_path)
+                except UnresolvedPath:
+                    return  # already reported
+            pts.append(geometry_points(geom, mesh))
+        if not pts or not len(np.concatenate(pts)):
+            c.warn((*loc, "finger_links"), f"finger link {fl!r} has no geometry; cannot check tcp_offset")
+            return
+        P = np.concatenate(pts)
+        T = T_ee_inv @ urdf.link_pose(fl, q)
+        P_ee = P @ T[:3, :3].T + T[:3, 3]
+        tip = P_ee[:, axis].max()
+        pad = P_ee[P_ee[:, axis] >= tip - PAD_LENGTH]
+        pads.append((pad.min(axis=0) + pad.max(axis=0)) / 2)
+    mid = (pads[0] + pads[1]) / 2
+    along = mid[axis]
+    angle = np.degrees(np.arccos(np.clip(along / max(np.linalg.norm(mid), 1e-9), -1, 1)))
+    tcp_loc = ("arms", robot.config.arms.index(arm), "tcp_offset")
+    if along <= 0:
+        c.error(tcp_loc, f"the finger pads are on the −{arm.ee_axis} side of ee_link; ee_axis must point from ee_link towards the fingertips")
+    elif abs(along - arm.tcp_offset) > TCP_WARN_DIST or angle > TCP_WARN_ANGLE_DEG:
+        c.warn(tcp_loc, f"finger-pad midpoint (gripper open) is {along:.4f} m along {arm.ee_axis} and {angle:.1f}° off the axis; tcp_offset is {arm.tcp_offset:.4f} m")
+
+
+def _check_drives_and_physics(c: _Collector, robot: CheckedRobot) -> None:
+    cfg, urdf = robot.config, robot.urdf
+    for key in ("velocity_limits", "acceleration_limits"):
+        for name in getattr(cfg.drives, key):
+            _known(c, ("drives", key, name), name, list(urdf.joints), "joint")
+    for name in cfg.physics.link_masses:
+        _known(c, ("physics", "link_masses", name), name, list(urdf.links), "link")
+    for j in urdf.joints.values():
+        if not j.movable:
+            continue
+        moved = urdf.links.get(j.child)
+        if moved and (moved.mass is None or moved.mass <= 0) and j.child not in cfg.physics.link_masses:
+            c.warn(("physics", "link_masses"), f"moving link {j.child!r} has no <inertial> or zero mass (PyBullet would make it 1 kg); set physics.link_masses.{j.child}")

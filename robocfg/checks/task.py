@@ -1,0 +1,97 @@
+"""Load a task YAML, validate it, load the robots it names, and check the command block."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from pydantic import TypeAdapter
+
+from robocfg.checks.robot import CheckedRobot, load_robot
+from robocfg.config import catalog
+from robocfg.config.load import YamlDocument, load_yaml, validate_document
+from robocfg.config.robot import ParallelGripperConfig
+from robocfg.config.task import PickPlaceTask, TaskConfig
+from robocfg.errors import ConfigError, NotFound, Problem
+
+_TASK_ADAPTER: TypeAdapter | None = None
+
+
+def task_adapter() -> TypeAdapter:
+    global _TASK_ADAPTER
+    if _TASK_ADAPTER is None:
+        _TASK_ADAPTER = TypeAdapter(TaskConfig)
+    return _TASK_ADAPTER
+
+
+@dataclass
+class CheckedTask:
+    config: TaskConfig
+    doc: YamlDocument
+    robots: list[CheckedRobot]
+    warnings: list[Problem] = field(default_factory=list)
+
+    @property
+    def path(self) -> Path:
+        return self.doc.path
+
+
+def load_task(path: str | Path, strict: bool = False, robot_override: str | None = None) -> CheckedTask:
+    """Load and check a task YAML. ``robot_override`` replaces the first robot (``--robot NAME``)."""
+    doc = load_yaml(path)
+    if robot_override is not None and isinstance(doc.data.get("robots"), list) and doc.data["robots"]:
+        first = dict(doc.data["robots"][0]) if isinstance(doc.data["robots"][0], dict) else {}
+        first.pop("robot_config_file", None)
+        first["robot"] = robot_override
+        doc.data["robots"][0] = first
+    config = validate_document(doc, task_adapter())
+    problems: list[Problem] = []
+    robots: list[CheckedRobot] = []
+    for i, mount in enumerate(config.robots):
+        loc = ("robots", i, "robot" if mount.robot else "robot_config_file")
+        try:
+            if mount.robot is not None:
+                rpath = catalog.find("robots", mount.robot)
+            else:
+                rpath = (doc.path.parent / mount.robot_config_file).resolve()  # type: ignore[operator]
+                if not rpath.is_file():
+                    raise NotFound("robot file", str(mount.robot_config_file), [])
+            robots.append(load_robot(rpath, strict=strict))
+        except NotFound as exc:
+            problems.append(doc.problem(loc, str(exc)))
+        except ConfigError as exc:
+            problems.append(doc.problem(loc, f"robot {mount.robot or mount.robot_config_file!r} is invalid ({len(exc.problems)} problem(s) below)"))
+            problems.extend(exc.problems)
+    warnings: list[Problem] = []
+    if not problems and isinstance(config, PickPlaceTask):
+        _check_pick_place(doc, config, robots[0], problems, warnings)
+    if problems or (strict and warnings):
+        raise ConfigError(problems + (warnings if strict else []))
+    return CheckedTask(config, doc, robots, warnings)
+
+
+def _check_pick_place(doc: YamlDocument, task: PickPlaceTask, robot: CheckedRobot,
+                      problems: list[Problem], warnings: list[Problem]) -> None:
+    arm = robot.config.arms[0]
+    g = arm.gripper
+    if g is None:
+        problems.append(doc.problem(("robots", 0), f"robot {robot.config.name!r} has no gripper (arms[0].gripper is missing in {robot.path}); pick-place needs one"))
+        return
+    obj = task.pick_place.object
+    if isinstance(g, ParallelGripperConfig):
+        narrow = _narrowest_horizontal(obj.shape, obj.size)
+        if narrow >= g.max_width:
+            problems.append(doc.problem(("pick_place", "object", "size"),
+                                        f"object is {narrow * 1000:.1f} mm across its narrowest side, wider than the gripper's max_width {g.max_width * 1000:.1f} mm"))
+    place = np.asarray(task.pick_place.place_position)
+    for k, ob in enumerate(task.scene.obstacles):
+        half = np.asarray(ob.size if ob.shape == "box" else [ob.size[0] * 2] * 3) / 2
+        if np.all(np.abs(place[:2] - np.asarray(ob.position[:2])) <= half[:2]):
+            warnings.append(doc.problem(("pick_place", "place_position"), f"place position is inside obstacle {ob.name!r} (scene.obstacles[{k}])", "warning"))
+
+
+def _narrowest_horizontal(shape: str, size: list[float]) -> float:
+    if shape in ("box", "mesh"):
+        return min(size[0], size[1])
+    return 2 * size[0]

@@ -1,0 +1,54 @@
+"""Options and helpers shared by every command (defined once)."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+JsonOpt = Annotated[Path | None, typer.Option("--json", help="Write a JSON report to this path.", dir_okay=False)]
+QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print only the result.")]
+StrictOpt = Annotated[bool, typer.Option("--strict", help="Treat warnings as errors.")]
+RobotOpt = Annotated[str | None, typer.Option("--robot", "-r", help="Robot name or YAML path (replaces the task's first robot).")]
+GuiOpt = Annotated[bool, typer.Option("--gui", help="Open the PyBullet GUI instead of running headless.")]
+RecordOpt = Annotated[Path | None, typer.Option("--record", help="Save pictures: .gif (animation) or .png (last frame).", dir_okay=False)]
+SeedOpt = Annotated[int | None, typer.Option("--seed", help="Random seed (overrides the task's sim.seed).")]
+
+
+def debug_enabled() -> bool:
+    return os.environ.get("ROBOCFG_DEBUG", "") not in ("", "0")
+
+
+def console(stderr: bool = False):
+    import sys
+
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    width = None if stream.isatty() else 160
+    return Console(stderr=stderr, highlight=False, soft_wrap=True, width=width)
+
+
+def write_json(path: Path | None, payload: Any) -> None:
+    """Write ``payload`` (a pydantic model, dataclass or plain data) as indented JSON."""
+    if path is None:
+        return
+    if hasattr(payload, "model_dump"):
+        payload = payload.model_dump(mode="json")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(payload, indent=2, sort_keys=False, default=_default) + "\n")
+
+
+def _default(o: Any) -> Any:
+    import dataclasses
+
+    if dataclasses.is_dataclass(o):
+        return dataclasses.asdict(o)  # type: ignore[arg-type]
+    if hasattr(o, "tolist"):
+        return o.tolist()
+    if isinstance(o, Path):
+        return str(o)
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")

@@ -1,0 +1,69 @@
+"""``robocfg validate``: check robot and task YAMLs (kind detected), directories recursively."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from robocfg.cli.common import JsonOpt, StrictOpt, console, write_json
+
+
+def validate(
+    paths: Annotated[list[Path] | None, typer.Argument(help="YAML files or directories; none = all built-ins.")] = None,
+    strict: StrictOpt = False,
+    json_path: JsonOpt = None,
+) -> int:
+    """Check robot and task YAMLs against their schema and URDFs. Exit 0 valid, 2 invalid."""
+    from rich.table import Table
+
+    from robocfg.checks import load_robot, load_task
+    from robocfg.config import catalog
+    from robocfg.config.load import detect_kind, load_yaml
+    from robocfg.errors import ConfigError
+
+    files = _collect(paths) if paths else [*catalog.available("robots").values(), *catalog.available("tasks").values()]
+    out, err = console(), console(stderr=True)
+    table = Table(title="robocfg validate", show_lines=False)
+    for col in ("file", "kind", "status", "errors", "warnings"):
+        table.add_column(col)
+    records, any_error = [], False
+    for f in files:
+        kind, problems, warnings = "?", [], []
+        try:
+            kind = detect_kind(load_yaml(f))
+            checked = load_robot(f, strict) if kind == "robot" else load_task(f, strict)
+            warnings = checked.warnings
+        except ConfigError as exc:
+            problems = exc.problems
+        errors = [p for p in problems if p.severity == "error"]
+        warnings = warnings + [p for p in problems if p.severity == "warning"]
+        failed = bool(problems)
+        any_error |= failed
+        status = "[red]invalid[/red]" if failed else ("[yellow]ok (warnings)[/yellow]" if warnings else "[green]ok[/green]")
+        table.add_row(_short(f), kind, status, str(len(errors)), str(len(warnings)))
+        for p in [*problems, *([w for w in warnings if w not in problems])]:
+            err.print(p.format(), markup=False)
+        records.append({"file": str(f), "kind": kind, "valid": not failed,
+                        "problems": [p.__dict__ for p in problems], "warnings": [w.__dict__ for w in warnings]})
+    out.print(table)
+    write_json(json_path, {"valid": not any_error, "files": records})
+    return 2 if any_error else 0
+
+
+def _collect(paths: list[Path]) -> list[Path]:
+    files: list[Path] = []
+    for p in paths:
+        if p.is_dir():
+            files += sorted(x for x in p.rglob("*") if x.suffix in (".yaml", ".yml"))
+        else:
+            files.append(p)
+    return files
+
+
+def _short(p: Path) -> str:
+    try:
+        return str(p.resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return str(p)

@@ -1,0 +1,1 @@
+"""Pure-data configuration: pydantic models and the YAML loader. Never imports simulators."""

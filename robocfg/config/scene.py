@@ -1,0 +1,86 @@
+"""Scene models for task YAMLs: ground, table, pedestal, objects, obstacles. Sizes in metres, mass in kg."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from robocfg.config.types import Frozen, NonNegFloat, Pose, PositiveFloat, Vec3, Vec4
+
+Color = Vec4
+
+
+class Body(Pose):
+    """A primitive body. ``size`` means: box → full extents [x, y, z]; sphere → [radius];
+    cylinder/capsule → [radius, length]; mesh → scale [sx, sy, sz]."""
+
+    name: str
+    shape: Literal["box", "sphere", "cylinder", "capsule", "mesh"] = "box"
+    size: Annotated[list[PositiveFloat], Field(min_length=1, max_length=3)] = Field(description="See class doc (m).")
+    mesh: str | None = Field(None, description="Mesh or URDF path for shape: mesh (relative, or pybullet_data://).")
+    mass: NonNegFloat = Field(0.1, description="kg; 0 makes the body static.")
+    friction: PositiveFloat = Field(1.0, description="Lateral friction coefficient.")
+    color: Color = Field(default_factory=lambda: [0.8, 0.3, 0.2, 1.0], description="RGBA, 0..1.")
+
+    @model_validator(mode="after")
+    def _size_for_shape(self) -> Body:
+        need = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": 3}[self.shape]
+        if len(self.size) != need:
+            raise ValueError(f"shape '{self.shape}' needs size with {need} value(s), got {len(self.size)}")
+        if self.shape == "mesh" and not self.mesh:
+            raise ValueError("shape 'mesh' needs a 'mesh' path")
+        return self
+
+    def half_height(self) -> float:
+        """Half the extent along the body's own z axis (m)."""
+        if self.shape in ("box", "mesh"):
+            return self.size[2] / 2
+        if self.shape == "sphere":
+            return self.size[0]
+        return self.size[1] / 2 + (self.size[0] if self.shape == "capsule" else 0.0)
+
+
+class Table(Pose):
+    """A static box table; ``position`` is the centre of its top surface."""
+
+    size: Vec3 = Field(default_factory=lambda: [0.8, 1.2, 0.05], description="Top extents (m).")
+    color: Color = Field(default_factory=lambda: [0.6, 0.5, 0.4, 1.0])
+    friction: PositiveFloat = 1.0
+
+
+class Pedestal(Pose):
+    """A static cylinder the robot stands on; ``position`` is the centre of its top face."""
+
+    radius: PositiveFloat = 0.15
+    height: PositiveFloat = 0.5
+    color: Color = Field(default_factory=lambda: [0.3, 0.3, 0.3, 1.0])
+
+
+class Scene(Frozen):
+    """Everything in the world except the robots."""
+
+    ground: bool = Field(True, description="Add a ground plane at z = 0.")
+    table: Table | None = None
+    pedestal: Pedestal | None = None
+    objects: list[Body] = Field(default_factory=list, description="Movable objects.")
+    obstacles: list[Body] = Field(default_factory=list, description="Static obstacles (mass is ignored).")
+
+    @model_validator(mode="after")
+    def _unique_names(self) -> Scene:
+        names = [b.name for b in [*self.objects, *self.obstacles]]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ValueError(f"object/obstacle names must be unique: {sorted(dup)}")
+        return self
+
+
+class Sim(Frozen):
+    """Simulation settings."""
+
+    timestep: PositiveFloat = Field(1.0 / 240.0, description="Physics step (s).")
+    seed: int = Field(0, description="Seed for every random choice.")
+    gui: bool = Field(False, description="Open the PyBullet GUI (same as --gui).")
+    max_duration: PositiveFloat = Field(60.0, description="Simulated-time cap for a run (s).")
+    gravity: Vec3 = Field(default_factory=lambda: [0.0, 0.0, -9.81], description="m/s².")
+    solver_iterations: int | None = Field(None, ge=1, description="Overrides the robot's physics.solver_iterations.")

@@ -1,0 +1,71 @@
+"""Task YAML schema: ``task:`` selects the command; the command's block holds its parameters."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from robocfg.config.commands import (
+    FollowTargetParams,
+    GraspParams,
+    GripperParams,
+    PickPlaceParams,
+    TrajectoryParams,
+)
+from robocfg.config.scene import Scene, Sim
+from robocfg.config.types import Frozen, Pose
+
+
+class RobotMount(Pose):
+    """Which robot, and where its base stands (world frame)."""
+
+    robot: str | None = Field(None, description="Robot name on the search path (e.g. 'panda').")
+    robot_config_file: str | None = Field(None, description="Path to a robot YAML, relative to this task file.")
+    ignore_substring: list[str] = Field(default_factory=list, description="Bodies whose name contains one of these do not collide with the robot.")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> RobotMount:
+        if (self.robot is None) == (self.robot_config_file is None):
+            raise ValueError("give exactly one of 'robot' (a name) or 'robot_config_file' (a path)")
+        return self
+
+
+class _TaskBase(Frozen):
+    schema_version: Literal[1] = Field(description="File format version; this is 1.")
+    description: str = ""
+    robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
+    scene: Scene = Field(default_factory=Scene)
+    sim: Sim = Field(default_factory=Sim)
+
+
+class GripperTask(_TaskBase):
+    task: Literal["gripper"]
+    gripper: GripperParams = Field(default_factory=GripperParams)
+
+
+class TrajectoryTask(_TaskBase):
+    task: Literal["trajectory"]
+    trajectory: TrajectoryParams = Field(default_factory=TrajectoryParams)
+
+
+class FollowTargetTask(_TaskBase):
+    task: Literal["follow_target"]
+    follow_target: FollowTargetParams = Field(default_factory=FollowTargetParams)
+
+
+class PickPlaceTask(_TaskBase):
+    task: Literal["pick_place"]
+    pick_place: PickPlaceParams
+
+
+class GraspTask(_TaskBase):
+    task: Literal["grasp"]
+    grasp: GraspParams = Field(default_factory=GraspParams)
+
+
+TaskConfig = Annotated[
+    GripperTask | TrajectoryTask | FollowTargetTask | PickPlaceTask | GraspTask,
+    Field(discriminator="task"),
+]
+TASK_KINDS = ("gripper", "trajectory", "follow_target", "pick_place", "grasp")
