@@ -1,0 +1,127 @@
+"""``robocfg run pick-place [TASK]``: the 8-phase pick and place, one or many seeded episodes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from robocfg.cli.common import (
+    GuiOpt,
+    JsonOpt,
+    QuietOpt,
+    RecordOpt,
+    RobotOpt,
+    SeedOpt,
+    console,
+    write_json,
+)
+
+
+def run_pick_place(
+    task: Annotated[str, typer.Argument(help="Task name or YAML path (a 'task: pick_place' file).")] = "pick_place",
+    robot: RobotOpt = None,
+    arm: Annotated[str | None, typer.Option("--arm", help="Arm to use on a multi-arm robot (default: the first).")] = None,
+    episodes: Annotated[int, typer.Option("--episodes", "-n", min=1, help="Number of randomised episodes.")] = 1,
+    seed: SeedOpt = None,
+    json_path: JsonOpt = None,
+    record: RecordOpt = None,
+    record_episode: Annotated[int, typer.Option("--record-episode", min=0, help="Which episode --record films.")] = 0,
+    min_success: Annotated[float, typer.Option("--min-success", min=0.0, max=1.0,
+                                               help="Exit 1 when the success rate is below this.")] = 1.0,
+    gui: GuiOpt = False,
+    quiet: QuietOpt = False,
+) -> int:
+    """Pick the task's object and place it, robot-agnostic (grasp → EE by R_ee_graspnet, ee_axis, tcp_offset).
+
+    Exit 0 when the success rate reaches --min-success (default: every episode), 1 otherwise; the
+    --json report (one record per episode; no wall-clock figures, so the same seed gives the same
+    file) is written either way.
+    """
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.config.task import PickPlaceTask
+    from robocfg.errors import ConfigError
+    from robocfg.sim.quiet import quiet_import
+
+    quiet_import()
+    from robocfg.runners.pick_place import run_pick_place as run
+
+    checked = load_task(catalog.find("tasks", task), robot_override=robot)
+    if not isinstance(checked.config, PickPlaceTask):
+        raise ConfigError([checked.doc.problem(("task",), f"'run pick-place' needs a 'task: pick_place' file, "
+                                                         f"this is 'task: {checked.config.task}'")])
+    checked.robots[0].config.arm(arm)  # unknown arm → NotFound before any simulation
+    out = console()
+    for w in checked.warnings:
+        console(stderr=True).print(w.format(), markup=False)
+    recorder = _recorder_factory(record) if record else None
+    log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
+    if episodes > 1 and not quiet:
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeRemainingColumn,
+        )
+
+        with Progress(TextColumn("pick-place"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[ok]}"),
+                      TimeRemainingColumn(), console=console(stderr=True), transient=True) as bar:
+            tid = bar.add_task("episodes", total=episodes, ok="")
+            done = {"ok": 0}
+
+            def tick(res) -> None:
+                done["ok"] += res.success
+                bar.update(tid, advance=1, ok=f"{done['ok']} placed")
+
+            report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, tick)
+    else:
+        report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log)
+    write_json(json_path, report)
+    _print(report, timing, record, quiet)
+    return 0 if report.summary.success_rate >= min_success else 1
+
+
+def _recorder_factory(path: Path):
+    def make(world):
+        from robocfg.sim.record import CameraView, Recorder
+
+        return Recorder(world, path, fps=12.0, camera=CameraView(target=(0.35, 0.05, 0.15), distance=1.3,
+                                                                  yaw_deg=30.0, pitch_deg=-30.0))
+
+    return make
+
+
+def _print(report, timing, record, quiet: bool) -> None:
+    out = console()
+    s = report.summary
+    failed = [e for e in report.episodes if not e.success]
+    if quiet:
+        out.print(f"{'ok' if not failed else 'failed'}: {report.robot} placed {s.successes}/{s.episodes} "
+                  f"({s.success_rate:.1%}), {s.mean_sim_time:.2f} s simulated per episode", markup=False)
+        return
+    from rich.table import Table
+
+    table = Table(title=f"run pick-place: {report.robot} (arm {report.arm}), seed {report.seed}", show_header=False)
+    table.add_column("key")
+    table.add_column("value")
+    rows = [("episodes", str(s.episodes)), ("success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%})"),
+            ("failures by phase", ", ".join(f"{k}: {v}" for k, v in s.failures_by_phase.items()) or "none"),
+            ("simulated time / episode", f"{s.mean_sim_time:.2f} s"),
+            ("wall time / episode", f"{timing.mean_episode:.3f} s (total {timing.wall_time:.1f} s)")]
+    if s.episodes == 1:
+        e = report.episodes[0]
+        rows += [("place error", f"{e.place_error * 100:.2f} cm"), ("tilt", f"{e.tilt_deg:.1f}°")]
+    if record:
+        rows.append(("record", str(record)))
+    for k, v in rows:
+        table.add_row(k, v)
+    out.print(table)
+    for e in failed[:20]:
+        out.print(f"[red]episode {e.index} (seed {e.seed}) failed[/red]: {e.failed_phase}: {e.reason}")
+    if len(failed) > 20:
+        out.print(f"... and {len(failed) - 20} more failures (see --json)")
+    if not failed:
+        out.print("[green]ok[/green]")

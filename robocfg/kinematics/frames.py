@@ -1,0 +1,79 @@
+"""Grasp frames and the one conversion every grasping command uses (design.md §3).
+
+GraspNet grasp frame: origin at the grasp centre between the fingers, x = approach direction
+(gripper → object), y = finger closing direction, z = x × y. ``R_ee_graspnet`` is constant with
+``world_R_ee = world_R_grasp · R_ee_graspnet``; the EE origin sits ``tcp_offset`` behind the TCP
+along the EE's ``ee_axis``. All poses are 4x4 homogeneous matrices in the world frame (m).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.config.robot import ArmConfig
+from robocfg.config.types import AXIS_INDEX
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """A grasp: ``center`` (m, world), ``rotation`` world_R_grasp (3x3), ``width`` finger gap (m)."""
+
+    center: np.ndarray
+    rotation: np.ndarray
+    width: float
+
+    def approach(self) -> np.ndarray:
+        return self.rotation[:, 0]
+
+    def closing(self) -> np.ndarray:
+        return self.rotation[:, 1]
+
+
+def grasp_rotation(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
+    """world_R_grasp from an approach and a closing direction (closing is orthogonalised)."""
+    x = np.asarray(approach, float) / np.linalg.norm(approach)
+    y = np.asarray(closing, float) - np.dot(closing, x) * x
+    n = np.linalg.norm(y)
+    if n < 1e-9:
+        raise ValueError("closing direction is parallel to the approach direction")
+    y /= n
+    return np.column_stack([x, y, np.cross(x, y)])
+
+
+def ee_pose_from_grasp(grasp: Grasp, arm: ArmConfig, standoff: float = 0.0) -> np.ndarray:
+    """World pose of ``ee_link`` that puts the TCP at the grasp centre (moved back along the
+    approach by ``standoff`` metres), with ``world_R_ee = world_R_grasp · R_ee_graspnet``."""
+    R_ee = grasp.rotation @ np.asarray(arm.R_ee_graspnet, float)
+    tcp = np.asarray(grasp.center, float) - standoff * grasp.approach()
+    T = np.eye(4)
+    T[:3, :3] = R_ee
+    T[:3, 3] = tcp - arm.tcp_offset * R_ee[:, AXIS_INDEX[arm.ee_axis]]
+    return T
+
+
+def tcp_from_ee(T_ee: np.ndarray, arm: ArmConfig) -> np.ndarray:
+    """World pose of the TCP given the world pose of ``ee_link``."""
+    T = np.array(T_ee, float)
+    T[:3, 3] = T_ee[:3, 3] + arm.tcp_offset * T_ee[:3, AXIS_INDEX[arm.ee_axis]]
+    return T
+
+
+def top_down_grasps(center: np.ndarray, yaw: float, extent_xy: tuple[float, float]) -> list[Grasp]:
+    """The two top-down grasps of an upright object with yaw ``yaw`` (rad) and horizontal extents
+    (along its own x and y, m): approach straight down, fingers closing across the narrower side.
+    The two differ by a half turn about the approach axis; callers pick the one closer to the
+    current wrist orientation."""
+    ex, ey = extent_xy
+    axis_x = np.array([np.cos(yaw), np.sin(yaw), 0.0])
+    axis_y = np.array([-np.sin(yaw), np.cos(yaw), 0.0])
+    closing, width = (axis_x, ex) if ex <= ey else (axis_y, ey)
+    down = np.array([0.0, 0.0, -1.0])
+    return [Grasp(np.asarray(center, float), grasp_rotation(down, s * closing), width) for s in (1.0, -1.0)]
+
+
+def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
+    """Angle (rad) of the rotation between two rotation matrices."""
+    c = (np.trace(Ra.T @ Rb) - 1.0) / 2.0
+    return float(np.arccos(np.clip(c, -1.0, 1.0)))

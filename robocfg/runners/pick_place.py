@@ -1,0 +1,393 @@
+"""``run pick-place``: the 8-phase pick-and-place state machine, robot-agnostic.
+
+Every target comes from the robot YAML through one conversion (design.md §3): a top-down
+GraspNet grasp (approach straight down, fingers closing across the object's narrower horizontal
+side) → ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``) → IK → a
+time-optimal joint trajectory (toppra through IK waypoints along straight TCP lines) → position
+drives. The object is held by friction only (parallel grippers) or by the suction cup.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.checks.task import CheckedTask
+from robocfg.config.commands import Limits, PickPlaceParams
+from robocfg.config.scene import Body
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, rotation_angle, top_down_grasps
+from robocfg.runners.pick_place_report import (
+    EpisodeResult,
+    PhaseRecord,
+    PickPlaceReport,
+    PickPlaceTiming,
+    summarise,
+)
+
+Log = Callable[[str], None]
+CARTESIAN_STEP = 0.03  # m between IK waypoints on straight TCP lines
+SETTLE_POLL = 4  # physics steps between convergence checks
+RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
+
+
+class PhaseFailed(Exception):
+    def __init__(self, phase: str, reason: str):
+        self.phase, self.reason = phase, reason
+        super().__init__(f"{phase}: {reason}")
+
+
+@dataclass(frozen=True)
+class EpisodeSetup:
+    """What an episode randomised: object body, place point (m), seed."""
+
+    index: int
+    seed: int
+    body: Body
+    yaw: float  # rad
+    place_xy: np.ndarray
+
+
+def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[EpisodeSetup]:
+    """Randomised episode parameters, a fixed function of ``seed`` (episode k uses seed + k)."""
+    out = []
+    obj = params.object
+    rz = params.randomize
+    base_yaw = math.radians((obj.euler_deg or [0, 0, 0])[2])
+    for k in range(episodes):
+        rng = np.random.default_rng([seed, k])
+        dx, dy = (rng.uniform(-1, 1, 2) * np.asarray(rz.object.xy_range))
+        dyaw = math.radians(rng.uniform(-1, 1) * rz.object.yaw_range_deg)
+        px, py = (rng.uniform(-1, 1, 2) * np.asarray(rz.place.xy_range))
+        mass = obj.mass * (1 + rng.uniform(-1, 1) * rz.mass_scale)
+        friction = obj.friction * (1 + rng.uniform(-1, 1) * rz.friction_scale)
+        yaw = base_yaw + dyaw
+        roll, pitch = (obj.euler_deg or [0, 0, 0])[:2]
+        body = obj.model_copy(update={
+            "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
+            "euler_deg": [roll, pitch, math.degrees(yaw)], "quat_xyzw": None, "quat_wxyz": None,
+            "mass": mass, "friction": friction,
+        })
+        place = np.asarray(params.place_position[:2]) + np.array([px, py])
+        out.append(EpisodeSetup(k, seed + k, body, yaw, place))
+    return out
+
+
+def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm: str | None = None,
+                   gui: bool = False, record=None, record_episode: int = 0, log: Log | None = None,
+                   on_episode: Callable[[EpisodeResult], None] | None = None) -> tuple[PickPlaceReport, PickPlaceTiming]:
+    """Run ``episodes`` episodes in one world, restored to the same snapshot before each; returns
+    the report (deterministic for a seed) and wall times.
+
+    ``record`` is a callable ``world -> Recorder`` used for episode ``record_episode``; ``log``
+    receives the phase log of episode 0.
+    """
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.limits import limits_from_robot
+    from robocfg.sim.world import World
+
+    params: PickPlaceParams = task.config.pick_place  # type: ignore[union-attr]
+    seed = task.config.sim.seed if seed is None else seed
+    robot = task.robots[0]
+    arm_cfg = robot.config.arm(arm)
+    results, timing = [], PickPlaceTiming()
+    t_all = time.perf_counter()
+    with World(task, gui=gui) as world:
+        world.step(1)
+        state = world.snapshot()
+        handle = world.robot.arm(arm_cfg.name)
+        tools = _Tools(
+            KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=world.robot.base_pose()),
+            limits_from_robot(robot, handle.joints, Limits(velocity_scale=params.speed_scale,
+                                                           acceleration_scale=params.speed_scale)),
+        )
+        for setup in episode_setups(params, seed, episodes):
+            t0 = time.perf_counter()
+            if setup.body.name in world.bodies:
+                world.remove_body(setup.body.name)
+            world.restore(state)
+            recorder = record(world) if (record is not None and setup.index == record_episode) else None
+            sm = _StateMachine(world, handle, tools, params, setup, recorder, log if setup.index == 0 else None)
+            try:
+                sm.run()
+                failed, reason = None, "placed"
+            except PhaseFailed as exc:
+                failed, reason = exc.phase, exc.reason
+                sm.close_phase(False, reason)
+            if recorder is not None:
+                recorder.save()
+            res = sm.result(failed, reason)
+            timing.per_episode.append(time.perf_counter() - t0)
+            results.append(res)
+            if on_episode:
+                on_episode(res)
+    timing.wall_time = time.perf_counter() - t_all
+    report = PickPlaceReport(task=str(task.path), robot=robot.config.name, arm=arm_cfg.name, seed=seed,
+                             summary=summarise(results), episodes=results, warnings=[w.format() for w in task.warnings])
+    return report, timing
+
+
+@dataclass(frozen=True)
+class _Tools:
+    """Per-run helpers shared by every episode: kinematic model and scaled joint limits."""
+
+    model: object
+    limits: object
+
+
+class _StateMachine:
+    def __init__(self, world, arm, tools: _Tools, params: PickPlaceParams, setup: EpisodeSetup, recorder,
+                 log: Log | None):
+        self.world, self.params, self.setup, self.recorder = world, params, setup, recorder
+        self.log = log or (lambda _msg: None)
+        self.arm, self.cfg, self.gripper = arm, arm.config, arm.gripper
+        self.model, self.limits = tools.model, tools.limits
+        if params.grip_force is not None and hasattr(self.gripper, "set_force"):
+            self.gripper.set_force(params.grip_force)
+        self.obj = world.add_body(setup.body)
+        self.phases: list[PhaseRecord] = []
+        self._phase: tuple[str, float] | None = None
+        self.lift_rise: float | None = None
+
+    # ---- phases ------------------------------------------------------------------------------
+    def run(self) -> None:
+        p = self.params
+        self._open_gripper()
+        self._settle(0.2)
+        obj_pos, _ = self.world.body_pose(self.obj)
+        self.support_z = obj_pos[2] - self.setup.body.half_height()
+        center = obj_pos + np.array([0, 0, p.grasp_depth])
+        grasp = self._choose_grasp(center)
+        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
+        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
+
+        self.begin("pre_grasp", "move above the object")
+        self._move(T_pre, straight=False)
+        self.begin("approach", "down to grasp height")
+        self._move(T_grasp, straight=True)
+        self.begin("grasp", "close the gripper")
+        self._grasp()
+        self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
+        z0 = self.world.body_pose(self.obj)[0][2]
+        T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
+        self._move(T_lift, straight=True)
+        self._verify_lift(z0)
+        # Carry the object so that *it* lands on the place point: keep its offset from the EE.
+        obj_now = self.world.body_pose(self.obj)[0]
+        ee_now = self.arm.ee_pose()[:3, 3]
+        offset = ee_now - obj_now
+        place_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height() + RELEASE_CLEARANCE
+        place_obj = np.array([*self.setup.place_xy, place_z])
+        T_place = T_lift.copy()
+        T_place[:3, 3] = place_obj + offset
+        T_above_place = T_place.copy()
+        T_above_place[2, 3] = max(T_lift[2, 3], T_place[2, 3] + p.lift_height)
+        self.begin("transport", "carry above the place point")
+        self._move(T_above_place, straight=False, check_held=True)
+        self.begin("lower", "lower onto the support")
+        self._move(T_place, straight=True, check_held=True)
+        self.begin("release", "open the gripper")
+        self._release()
+        self.begin("retract", "move up and away")
+        self._move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
+        self.close_phase(True)
+        self._settle(0.3)
+        self._check_placed()
+
+    def begin(self, name: str, what: str) -> None:
+        if self._phase is not None:
+            self.close_phase(True)
+        self._phase = (name, self.world.t)
+        n = len(self.phases) + 1
+        self.log(f"Phase {n}: {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
+
+    def close_phase(self, ok: bool, detail: str = "") -> None:
+        if self._phase is None:
+            return
+        name, t0 = self._phase
+        self.phases.append(PhaseRecord(name, round(t0, 6), round(self.world.t, 6), ok, detail))
+        self._phase = None
+
+    @property
+    def phase(self) -> str:
+        return self._phase[0] if self._phase else "setup"
+
+    def timeout(self) -> float:
+        return getattr(self.params.timeouts, self.phase)
+
+    # ---- motion ------------------------------------------------------------------------------
+    def _choose_grasp(self, center: np.ndarray) -> Grasp:
+        b = self.setup.body
+        extent = (b.size[0], b.size[1]) if b.shape in ("box", "mesh") else (2 * b.size[0], 2 * b.size[0])
+        R_now = self.arm.ee_pose()[:3, :3]
+        cands = top_down_grasps(center, self.setup.yaw, extent)
+        return min(cands, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+
+    def _solve(self, T: np.ndarray, seed: np.ndarray, what: str) -> np.ndarray:
+        res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=0.05)
+        if not res.converged:
+            raise PhaseFailed(self.phase, f"{what} unreachable (IK residual {res.pos_err * 1000:.1f} mm, {math.degrees(res.rot_err):.1f}°)")
+        return res.q
+
+    def _move(self, T_goal: np.ndarray, straight: bool, check_held: bool = False) -> None:
+        from robocfg.motion.follower import follow
+        from robocfg.motion.plan import plan_trajectory
+
+        q0 = self.arm.joint_positions()
+        T0 = self.model.fk(q0, "ee")
+        if straight:
+            n = max(2, math.ceil(np.linalg.norm(T_goal[:3, 3] - T0[:3, 3]) / CARTESIAN_STEP) + 1)
+            waypoints, q = [q0], q0
+            for s in np.linspace(0, 1, n)[1:]:
+                T = T_goal.copy()
+                T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
+                q = self._solve(T, q, "target")
+                waypoints.append(q)
+        else:
+            waypoints = [q0, self._solve(T_goal, q0, "target")]
+        W = np.asarray(waypoints)
+        if np.max(np.abs(W[-1] - W[0])) < 1e-6:
+            return
+        plan = plan_trajectory(W, self.limits)
+        if plan.duration > self.timeout():
+            raise PhaseFailed(self.phase, f"motion needs {plan.duration:.2f} s, more than the {self.timeout():.2f} s timeout")
+        t_start = self.world.t
+        follow(self.world, self.arm.joints, plan.trajectory, settle_time=0.0, on_step=self._on_step)
+        self._converge(T_goal, t_start)
+        if check_held and not self._held():
+            raise PhaseFailed(self.phase, f"object dropped ({self._object_to_tcp() * 100:.1f} cm from the TCP)")
+
+    def _converge(self, T_goal: np.ndarray, t_start: float) -> None:
+        p = self.params
+        while True:
+            T = self.arm.ee_pose()
+            dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
+            dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
+            if dp <= p.position_tolerance and dr <= p.orientation_tolerance:
+                return
+            if self.world.t - t_start > self.timeout():
+                raise PhaseFailed(self.phase, f"did not converge within {self.timeout():.1f} s (error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
+            self._step(SETTLE_POLL)
+
+    # ---- gripper -----------------------------------------------------------------------------
+    def _open_gripper(self) -> None:
+        if self.cfg.gripper.type == "suction":
+            self.gripper.off()
+        else:
+            self.gripper.open()
+
+    def _grasp(self) -> None:
+        t0 = self.world.t
+        if self.cfg.gripper.type == "suction":
+            self.gripper.on()
+            while not self.gripper.is_grasping(self.obj):
+                if self.world.t - t0 > self.timeout():
+                    raise PhaseFailed("grasp", "suction did not attach")
+                self._step(SETTLE_POLL)
+            return
+        self.gripper.close()
+        last, still = self.gripper.width(), 0.0
+        while still < 0.1:
+            self._step(SETTLE_POLL)
+            w = self.gripper.width()
+            still = still + SETTLE_POLL * self.world.dt if abs(w - last) < 2e-4 else 0.0
+            last = w
+            if self.world.t - t0 > self.timeout():
+                break
+        if not self.gripper.is_grasping(self.obj):
+            raise PhaseFailed("grasp", f"no contact on both fingers (width {self.gripper.width() * 1000:.1f} mm)")
+
+    def _release(self) -> None:
+        t0 = self.world.t
+        self._open_gripper()
+        while self.gripper.is_grasping(self.obj) or (self.cfg.gripper.type == "parallel" and self.gripper.fraction() < 0.9):
+            if self.world.t - t0 > self.timeout():
+                raise PhaseFailed("release", "the object did not come free")
+            self._step(SETTLE_POLL)
+
+    def _held(self) -> bool:
+        return bool(self.gripper.is_grasping(self.obj))
+
+    def _object_to_tcp(self) -> float:
+        return float(np.linalg.norm(self.world.body_pose(self.obj)[0] - self.arm.tcp_pose()[:3, 3]))
+
+    def _verify_lift(self, z0: float) -> None:
+        z1 = self.world.body_pose(self.obj)[0][2]
+        self.lift_rise = float(z1 - z0)
+        want = 0.5 * self.params.lift_height
+        if not self._held() or self.lift_rise < want:
+            below = self.arm.tcp_pose()[2, 3] - z1
+            raise PhaseFailed("lift", f"object slipped, {below * 100:.1f} cm below the fingers (rose {self.lift_rise * 100:.1f} cm)")
+
+    # ---- world helpers -----------------------------------------------------------------------
+    def _on_step(self) -> None:
+        if self.recorder is not None:
+            self.recorder.maybe_capture()
+
+    def _step(self, n: int) -> None:
+        for _ in range(n):
+            self.world.step()
+            self._on_step()
+
+    def _settle(self, seconds: float) -> None:
+        self._step(round(seconds / self.world.dt))
+
+    def _support_height(self, xy: np.ndarray) -> float:
+        """Height (m) of the first surface below ``xy`` that is not the robot or the object."""
+        import pybullet as pb
+
+        c = self.world.client
+        skip = {self.obj, *(r.body_id for r in self.world.robots)}
+        results = pb.rayTestBatch([[xy[0], xy[1], 5.0]], [[xy[0], xy[1], -1.0]], reportHitNumber=-1,
+                                  physicsClientId=c)
+        z = 0.0 if self.world.task.config.scene.ground else -math.inf
+        for hit in results:
+            if hit[0] >= 0 and hit[0] not in skip:
+                z = max(z, hit[3][2])
+        return z if math.isfinite(z) else self.support_z
+
+    def _check_placed(self) -> None:
+        p = self.params
+        pos, quat = self.world.body_pose(self.obj)
+        err = float(np.linalg.norm(pos[:2] - self.setup.place_xy))
+        tilt = self._tilt(quat)
+        rest_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height()
+        if err > p.success_tolerance:
+            raise PhaseFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
+        if tilt > p.max_tilt_deg:
+            raise PhaseFailed("place", f"object tilted {tilt:.1f}° (max {p.max_tilt_deg:.0f}°)")
+        if abs(pos[2] - rest_z) > 0.01:
+            raise PhaseFailed("place", f"object not resting on the support (centre {pos[2] * 100:.1f} cm, expected {rest_z * 100:.1f} cm)")
+
+    @staticmethod
+    def _tilt(quat) -> float:
+        from robocfg.sim.frames import quat_to_matrix
+
+        z = quat_to_matrix(quat)[:, 2]
+        return math.degrees(math.acos(max(-1.0, min(1.0, float(z[2])))))
+
+    def result(self, failed: str | None, reason: str) -> EpisodeResult:
+        pos, quat = self.world.body_pose(self.obj)
+        b, s = self.setup.body, self.setup
+        err = float(np.linalg.norm(pos[:2] - s.place_xy))
+        return EpisodeResult(
+            index=s.index, seed=s.seed, success=failed is None, failed_phase=failed, reason=reason,
+            object_start=[round(b.position[0], 6), round(b.position[1], 6), round(math.degrees(s.yaw), 4)],
+            place_target=[round(float(v), 6) for v in s.place_xy],
+            object_final=[round(float(v), 6) for v in pos],
+            place_error=round(err, 6), tilt_deg=round(self._tilt(quat), 4),
+            lift_rise=None if self.lift_rise is None else round(self.lift_rise, 6),
+            mass=round(b.mass, 6), friction=round(b.friction, 6),
+            sim_time=round(self.world.t, 6), steps=self.world.steps, phases=self.phases,
+        )
+
+
+def _shifted(T: np.ndarray, d) -> np.ndarray:
+    out = T.copy()
+    out[:3, 3] += np.asarray(d, float)
+    return out
+
+
