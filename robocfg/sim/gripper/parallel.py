@@ -1,0 +1,159 @@
+"""Parallel-jaw gripper: driven (leader) joints in position control, mimic followers geared.
+
+Width is *measured*: the closest distance between the two finger links' collision shapes
+(PyBullet ``getClosestPoints``, convex hulls), never the command echoed back. ``set_width`` inverts
+the pad gap computed by URDF forward kinematics over the closed→open travel
+(``robocfg.assets.fingers.width_curve``), so linkages whose width is not linear in the joint
+(Robotiq, xArm) get the width asked for; without finger geometry it falls back to a linear map
+between ``closed`` (``min_width``) and ``open`` (``max_width``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pybullet as p
+
+from robocfg.config.robot import ParallelGripperConfig
+from robocfg.sim.gripper.base import CLOSED, OPEN, Gripper
+from robocfg.sim.gripper.registry import register
+from robocfg.sim.robot import Drive
+
+
+@register("parallel")
+class ParallelGripper(Gripper):
+    """``open()``, ``close()``, ``set_width(m)``, ``width()`` (measured), ``state()``, ``is_grasping(body)``.
+
+    ``rate`` (fraction of the closed→open travel per second) makes targets move smoothly, like the
+    seed's "+0.1 per step"; ``None`` jumps the target at once (the drive's ``max_velocity`` still caps
+    the joint speed).
+    """
+
+    config: ParallelGripperConfig
+
+    def __init__(self, world: Any, arm: Any, rate: float | None = None):
+        super().__init__(world, arm)
+        cfg: ParallelGripperConfig = self.config
+        self.joints = self.robot.checked.gripper_joints(arm.config)
+        self.q_open = np.asarray(cfg.open, dtype=float)
+        self.q_closed = np.asarray(cfg.closed, dtype=float)
+        self.fingers = [self.robot.link(n) for n in cfg.finger_links]
+        self.rate = rate
+        self.force = cfg.max_force
+        gains = self.robot.config.drives.arm
+        self._gains = (gains.stiffness, gains.damping)
+        for f in self.fingers:
+            p.changeDynamics(self.robot.body_id, f, lateralFriction=cfg.lateral_friction, physicsClientId=self.client)
+        self._curve: tuple[np.ndarray, np.ndarray] | None = None  # (fractions, gaps), on first set_width
+        self._curve_done = False
+        self._goal = 1.0  # commanded opening fraction (0 closed, 1 open)
+        self._cmd = 1.0  # fraction currently sent to the drives (rate-limited towards _goal)
+        self._send()
+
+    # ---- commands (non-blocking) -----------------------------------------------------------
+    def open(self) -> None:
+        self.set_fraction(1.0)
+
+    def close(self) -> None:
+        self.set_fraction(0.0)
+
+    def set_width(self, width: float) -> None:
+        """Command a finger gap (m), clipped to what the fingers can do (the pad-gap curve, else [min_width, max_width])."""
+        cfg = self.config
+        if not self._curve_done:
+            self._curve, self._curve_done = _width_curve(self.robot.checked, self.arm.config), True
+        if self._curve is not None:
+            s, gaps = self._curve
+            order = np.argsort(gaps)
+            self.set_fraction(float(np.interp(width, gaps[order], s[order])))
+            return
+        self.set_fraction((width - cfg.min_width) / (cfg.max_width - cfg.min_width))
+
+    def set_fraction(self, s: float) -> None:
+        """Command an opening fraction: 0 = ``closed`` joint positions, 1 = ``open``."""
+        self._goal = float(np.clip(s, 0.0, 1.0))
+        if self.rate is None:
+            self._cmd = self._goal
+            self._send()
+
+    def set_force(self, force: float) -> None:
+        """Force (N) or torque (N·m) cap of each driven joint."""
+        self.force = float(force)
+        self._send()
+
+    def reset(self, fraction: float = 1.0) -> None:
+        """Teleport the fingers to an opening fraction (followers included) and hold there."""
+        self._goal = self._cmd = float(np.clip(fraction, 0.0, 1.0))
+        self.robot.reset_joints(self.joints, self._q(self._cmd), hold=False)
+        if self.robot.mimic is not None:
+            self.robot.mimic.sync()
+        self._send()
+
+    def update(self) -> None:
+        if self._cmd == self._goal:
+            return
+        step = self.rate * self.world.dt if self.rate is not None else 1.0
+        self._cmd = self._goal if abs(self._goal - self._cmd) <= step else self._cmd + np.sign(self._goal - self._cmd) * step
+        self._send()
+
+    def _q(self, s: float) -> np.ndarray:
+        return self.q_closed + s * (self.q_open - self.q_closed)
+
+    def _send(self) -> None:
+        kp, kd = self._gains
+        for n, q in zip(self.joints, self._q(self._cmd), strict=True):
+            self.robot.set_drive(n, Drive(float(q), kp, kd, self.force, max_velocity=self.config.max_velocity))
+
+    # ---- measurements ------------------------------------------------------------------------
+    @property
+    def target_fraction(self) -> float:
+        return self._goal
+
+    def width(self) -> float:
+        """Measured finger gap (m): closest distance between the finger links' collision shapes (≥ 0)."""
+        r = self.robot
+        pts = p.getClosestPoints(r.body_id, r.body_id, 1.0, self.fingers[0], self.fingers[1], physicsClientId=self.client)
+        if not pts:  # fingers without collision shapes: fall back to the distance between their frames
+            a, b = (r.link_pose(n)[:3, 3] for n in self.config.finger_links)
+            return float(np.linalg.norm(a - b))
+        return max(0.0, float(min(c[8] for c in pts)))
+
+    def fraction(self) -> float:
+        """Measured opening fraction of the driven joints (0 closed, 1 open), averaged."""
+        q = self.robot.joint_positions(self.joints)
+        return float(np.mean((q - self.q_closed) / (self.q_open - self.q_closed)))
+
+    def state(self) -> float:
+        """1.0 (open) when the measured fraction exceeds ``state_threshold``, else −1.0 (closed)."""
+        return OPEN if self.fraction() > self.config.state_threshold else CLOSED
+
+    def finger_contacts(self, body: int | str) -> list[int]:
+        """Number of contact points between each finger link and ``body``."""
+        bid = self._body_id(body)
+        return [len(p.getContactPoints(self.robot.body_id, bid, f, physicsClientId=self.client)) for f in self.fingers]
+
+    def is_grasping(self, body: int | str) -> bool:
+        """Both finger links touch ``body`` (a body id or a world body name)."""
+        bid = self._body_id(body)
+        return all(p.getContactPoints(self.robot.body_id, bid, f, physicsClientId=self.client) for f in self.fingers)
+
+
+def _width_curve(checked: Any, arm_cfg: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """Pad gap vs opening fraction from the URDF, or None when it cannot be computed or is not
+    monotonic (then ``set_width`` stays linear)."""
+    from robocfg.assets.fingers import FingerGeometryMissing, closing_axis, width_curve
+    from robocfg.assets.paths import Resolver
+    from robocfg.config.types import AXIS_INDEX
+
+    g = arm_cfg.gripper
+    try:
+        s, gaps = width_curve(checked.urdf, Resolver(checked.path.parent, checked.config.package_dirs), arm_cfg.ee_link,
+                              AXIS_INDEX[arm_cfg.ee_axis], list(g.finger_links), checked.gripper_joints(arm_cfg),
+                              g.open, g.closed, closing_axis(arm_cfg.R_ee_graspnet))
+    except (FingerGeometryMissing, KeyError, ValueError):
+        return None
+    d = np.diff(gaps)
+    if not (np.all(d >= -1e-6) or np.all(d <= 1e-6)) or np.ptp(gaps) < 1e-4:
+        return None
+    return s, gaps

@@ -1,0 +1,288 @@
+"""A PyBullet world built from a checked task: physics settings, scene, robots, mimic gears, grippers.
+
+One ``World`` = one PyBullet client (``DIRECT`` unless ``gui``); every call passes
+``physicsClientId`` so several worlds can live in one process. Use it as a context manager::
+
+    with World(task) as world:
+        world.robot.arm().gripper.close()
+        world.step(240)            # 1 s at 240 Hz
+        print(world.robot.arm().gripper.width())
+
+Frames: world z up, m. ``step()`` advances physics, updates the grippers, and raises
+``PhysicsDiverged`` on NaN or velocities beyond ``max_joint_velocity`` / ``max_body_speed``
+(checked every ``check_interval`` s of simulated time, so a divergence is reported within 20 ms).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pybullet as p
+
+from robocfg.checks.robot import CheckedRobot
+from robocfg.checks.task import CheckedTask
+from robocfg.config.robot import ParallelGripperConfig
+from robocfg.config.scene import Body
+from robocfg.config.task import RobotMount
+from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError
+from robocfg.sim.bodies import spawn_body, spawn_ground, spawn_pedestal, spawn_table
+from robocfg.sim.frames import quat_to_matrix
+from robocfg.sim.gripper import make_gripper
+from robocfg.sim.loading import load_robot_urdf
+from robocfg.sim.mimic import MimicGears
+from robocfg.sim.robot import RobotHandle
+
+MAX_JOINT_VELOCITY = 100.0  # rad/s or m/s: beyond this the physics is taken as diverged
+MAX_BODY_SPEED = 50.0  # m/s for free bodies
+CHECK_INTERVAL = 0.02  # s of simulated time between divergence checks (one check costs ≈ 30–60 µs)
+SPAWN_OVERLAP_WARN = 0.002  # m: penetration between a spawned body and a robot that earns a warning
+
+
+class World:
+    """Physics client + scene + robots. See the module docstring for the interface."""
+
+    def __init__(self, task: CheckedTask, gui: bool = False, max_joint_velocity: float = MAX_JOINT_VELOCITY,
+                 max_body_speed: float = MAX_BODY_SPEED, check_interval: float = CHECK_INTERVAL):
+        self.task = task
+        cfg = task.config
+        self.gui = gui or cfg.sim.gui
+        self.dt: float = cfg.sim.timestep
+        self.t: float = 0.0
+        self.steps = 0
+        self.max_joint_velocity, self.max_body_speed = max_joint_velocity, max_body_speed
+        self._check_every = max(1, round(check_interval / self.dt))
+        self.warnings: list[str] = []
+        self.bodies: dict[str, int] = {}
+        self.robots: list[RobotHandle] = []
+        self.mimic: dict[int, MimicGears] = {}
+        self._dynamic: list[int] = []
+        self._grippers: list = []
+        if self.gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+            raise RobocfgError("--gui needs a display (DISPLAY is not set); run headless without --gui, "
+                               "or under xvfb-run")
+        self.client: int = p.connect(p.GUI if self.gui else p.DIRECT)
+        if self.client < 0:
+            raise RobocfgError("cannot open the PyBullet GUI (is there a display?); run without --gui"
+                               if self.gui else "cannot start a PyBullet DIRECT client")
+        try:
+            self._build()
+        except BaseException:
+            self.close()
+            raise
+
+    # ---- context manager ----------------------------------------------------------------
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        if self.client is not None and self.client >= 0:
+            with contextlib.suppress(p.error):
+                p.disconnect(physicsClientId=self.client)
+            self.client = -1
+
+    # ---- building -----------------------------------------------------------------------
+    def _build(self) -> None:
+        c, cfg = self.client, self.task.config
+        if self.gui:
+            p.configureDebugVisualizer(p.COV_ENABLE_GUI, 0, physicsClientId=c)
+        p.setGravity(*cfg.sim.gravity, physicsClientId=c)
+        iters = cfg.sim.solver_iterations or self.task.robots[0].config.physics.solver_iterations
+        p.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSolverIterations=iters, physicsClientId=c)
+        scene, base_dir = cfg.scene, self.task.path.parent
+        if scene.ground:
+            self.bodies["ground"] = spawn_ground(c)
+        if scene.table is not None:
+            ids = spawn_table(c, scene.table)
+            self.bodies["table"] = ids[0]
+            for k, i in enumerate(ids[1:]):
+                self.bodies[f"table_leg_{k}"] = i
+        if scene.pedestal is not None:
+            self.bodies["pedestal"] = spawn_pedestal(c, scene.pedestal)
+        for mount, checked in zip(cfg.robots, self.task.robots, strict=True):
+            self.robots.append(self._load_robot(checked, mount))
+        for ob in scene.obstacles:
+            self._register(ob.name, spawn_body(c, ob, base_dir, static=True), dynamic=False)
+        for ob in scene.objects:
+            self._register(ob.name, spawn_body(c, ob, base_dir), dynamic=ob.mass > 0)
+        for mount, robot in zip(cfg.robots, self.robots, strict=True):
+            for name, bid in self.bodies.items():
+                if any(s in name for s in mount.ignore_substring):
+                    self._filter_robot_against(robot, bid)
+        for name in [*(o.name for o in scene.obstacles), *(o.name for o in scene.objects)]:
+            self._warn_overlap(name)
+
+    def _load_robot(self, checked: CheckedRobot, mount: RobotMount) -> RobotHandle:
+        c, phys = self.client, checked.config.physics
+        flags = p.URDF_USE_INERTIA_FROM_FILE
+        if phys.self_collision:
+            flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_EXCLUDE_ALL_PARENTS
+        body = load_robot_urdf(c, checked, mount.position, mount.quaternion_xyzw(), flags)
+        robot = RobotHandle(c, body, checked)
+        self.bodies.setdefault(robot.name, body)
+        if phys.self_collision:
+            self._filter_gripper_linkage(robot)
+        robot.mimic = self.mimic[body] = MimicGears(robot)
+        for w in robot.mimic.skipped:
+            self.warnings.append(f"robot {robot.name!r}: {w}")
+        followers = set(robot.mimic.followers)
+        for arm in robot.arms.values():
+            robot.reset_joints(arm.joints, arm.home, hold=False)
+            arm.command(arm.home)
+        others = [n for n in robot.movable_joints if n not in followers and n not in robot.drives]
+        gripper_joints = {n for a in robot.arms.values() for n in checked.gripper_joints(a.config)}
+        rest = [n for n in others if n not in gripper_joints]
+        if rest:  # joints no arm or gripper drives: hold them where they load
+            robot.command_positions(rest, robot.joint_positions(rest))
+        for arm in robot.arms.values():
+            arm.gripper = make_gripper(self, arm)
+            if arm.gripper is not None:
+                if hasattr(arm.gripper, "reset"):
+                    arm.gripper.reset(1.0)
+                self._grippers.append(arm.gripper)
+        robot.mimic.sync()
+        return robot
+
+    def _filter_gripper_linkage(self, robot: RobotHandle) -> None:
+        """No self-collision among the links a parallel gripper's joints move (leaders and mimic
+        followers): PyBullet's convex hulls of linkage parts overlap at rest and would jam."""
+        urdf = robot.checked.urdf
+        for arm in robot.arms.values():
+            g = arm.config.gripper
+            if not isinstance(g, ParallelGripperConfig):
+                continue
+            leaders = robot.checked.gripper_joints(arm.config)
+            joints = leaders + robot.checked.mimic_followers(leaders)
+            moved = set().union(*(urdf.descendants(j) for j in joints))
+            parents = {urdf.joints[j].parent for j in joints}
+            links = sorted((moved | parents) & set(robot.link_index))
+            for i, a in enumerate(links):
+                for b in links[i + 1 :]:
+                    p.setCollisionFilterPair(robot.body_id, robot.body_id, robot.link(a), robot.link(b), 0,
+                                             physicsClientId=self.client)
+
+    def _filter_robot_against(self, robot: RobotHandle, body: int) -> None:
+        for li in robot.link_index.values():
+            p.setCollisionFilterPair(robot.body_id, body, li, -1, 0, physicsClientId=self.client)
+
+    def _register(self, name: str, bid: int, dynamic: bool) -> int:
+        self.bodies[name] = bid
+        if dynamic:
+            self._dynamic.append(bid)
+        return bid
+
+    def _warn_overlap(self, name: str) -> None:
+        bid = self.bodies[name]
+        p.performCollisionDetection(physicsClientId=self.client)
+        for robot in self.robots:
+            pts = p.getContactPoints(robot.body_id, bid, physicsClientId=self.client)
+            worst = min((c for c in pts), key=lambda c: c[8], default=None)
+            if worst is not None and worst[8] < -SPAWN_OVERLAP_WARN:
+                self.warnings.append(f"body {name!r} is spawned inside robot {robot.name!r} "
+                                     f"(overlaps link {robot.link_name(worst[3])!r} by {-worst[8] * 1000:.1f} mm)")
+
+    # ---- bodies -------------------------------------------------------------------------
+    @property
+    def robot(self) -> RobotHandle:
+        """The first robot (the one that runs the task's command)."""
+        return self.robots[0]
+
+    def add_body(self, body: Body, static: bool = False) -> int:
+        """Spawn a box/sphere/cylinder/capsule/mesh body and register it under ``body.name``."""
+        if body.name in self.bodies:
+            self.remove_body(body.name)
+        bid = spawn_body(self.client, body, self.task.path.parent, static=static)
+        self._register(body.name, bid, dynamic=not static and body.mass > 0)
+        self._warn_overlap(body.name)
+        return bid
+
+    def remove_body(self, name: str) -> None:
+        bid = self.body_id(name)
+        p.removeBody(bid, physicsClientId=self.client)
+        del self.bodies[name]
+        if bid in self._dynamic:
+            self._dynamic.remove(bid)
+
+    def body_id(self, name_or_id: str | int) -> int:
+        if isinstance(name_or_id, str):
+            if name_or_id not in self.bodies:
+                raise NotFound("body", name_or_id, list(self.bodies))
+            return self.bodies[name_or_id]
+        return int(name_or_id)
+
+    def body_pose(self, name_or_id: str | int) -> tuple[np.ndarray, np.ndarray]:
+        """(position (3,), quat_xyzw (4,)) of a body's base (centre of mass frame for primitives)."""
+        pos, orn = p.getBasePositionAndOrientation(self.body_id(name_or_id), physicsClientId=self.client)
+        return np.asarray(pos), np.asarray(orn)
+
+    def set_body_pose(self, name_or_id: str | int, position, quat_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
+        """Teleport a body (velocity zeroed)."""
+        bid = self.body_id(name_or_id)
+        p.resetBasePositionAndOrientation(bid, list(position), list(quat_xyzw), physicsClientId=self.client)
+        p.resetBaseVelocity(bid, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
+
+    def body_rotation(self, name_or_id: str | int) -> np.ndarray:
+        return quat_to_matrix(self.body_pose(name_or_id)[1])
+
+    # ---- stepping -----------------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` physics steps of ``dt``; grippers update after each; divergence raises."""
+        c = self.client
+        for _ in range(n):
+            p.stepSimulation(physicsClientId=c)
+            self.steps += 1
+            self.t = self.steps * self.dt
+            for g in self._grippers:
+                g.update()
+            if self.steps % self._check_every == 0:
+                self._check()
+
+    def snapshot(self) -> int:
+        """Save the physics state (bodies, joints, contacts) to come back to with ``restore``.
+        Bodies added after the snapshot must be removed before restoring."""
+        return p.saveState(physicsClientId=self.client)
+
+    def restore(self, state: int) -> None:
+        """Return to a ``snapshot``: physics state restored, clock at zero, every arm held at its
+        restored joint positions and every gripper reset open."""
+        p.restoreState(stateId=state, physicsClientId=self.client)
+        self.t, self.steps = 0.0, 0
+        for robot in self.robots:
+            for arm in robot.arms.values():
+                arm.command(arm.joint_positions())
+                if arm.gripper is not None and hasattr(arm.gripper, "reset"):
+                    arm.gripper.reset(1.0)
+            if robot.mimic is not None:
+                robot.mimic.sync()
+
+    def check(self) -> None:
+        """Raise PhysicsDiverged on NaN or excessive velocities now (``step`` calls it periodically)."""
+        self._check()
+
+    def _check(self) -> None:
+        c, vmax = self.client, self.max_joint_velocity
+        for r in self.robots:
+            if not r.movable_joints:
+                continue
+            for name, s in zip(r.movable_joints, p.getJointStates(r.body_id, r._movable_indices, physicsClientId=c),
+                               strict=True):
+                if not abs(s[1]) <= vmax:  # also catches NaN
+                    raise PhysicsDiverged(self.t, f"robot {r.name!r} joint {name!r} velocity {s[1]:.3g}")
+        for bid in self._dynamic:
+            lin, _ = p.getBaseVelocity(bid, physicsClientId=c)
+            speed = math.sqrt(lin[0] ** 2 + lin[1] ** 2 + lin[2] ** 2)
+            if not speed <= self.max_body_speed:
+                name = next((k for k, v in self.bodies.items() if v == bid), str(bid))
+                raise PhysicsDiverged(self.t, f"body {name!r} speed {speed:.3g} m/s")
+
+    # ---- convenience ----------------------------------------------------------------------
+    @property
+    def path(self) -> Path:
+        return self.task.path
