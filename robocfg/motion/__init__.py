@@ -1,0 +1,2 @@
+"""Motion generation: trajectory timing and following, reactive target following (``reactive``),
+target motions (``targets``)."""

@@ -1,0 +1,59 @@
+"""Fast rest-to-rest timing of a joint path: a cubic spline through the waypoints, traversed with
+a minimum-jerk time law s(τ) = 10τ³ − 15τ⁴ + 6τ⁵.
+
+Not time-optimal (toppra is, see :mod:`robocfg.motion.timing`), but it costs ~0.1 ms instead of
+10–30 ms, which matters for controllers that plan every phase of every episode (pick-place). The
+duration is the smallest one for which the sampled joint velocities and accelerations stay within
+the limits (a bound that is tight at the peak of the time law). Units: rad, s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robocfg.motion.limits import JointLimits
+from robocfg.motion.trajectory import Trajectory
+
+PEAK_SPEED = 1.875  # max ds/dτ of the min-jerk law
+PEAK_ACCEL = 5.7735  # max |d²s/dτ²| of the min-jerk law
+SAMPLES = 64
+
+
+class MinJerkPath(Trajectory):
+    """q(t) = spline(s(t / T)), rest to rest, through ``waypoints`` (k, n) with k ≥ 2."""
+
+    def __init__(self, waypoints: np.ndarray, limits: JointLimits, min_duration: float = 0.05):
+        from scipy.interpolate import CubicSpline
+
+        W = np.asarray(waypoints, dtype=float)
+        seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
+        keep = np.concatenate([[True], seg > 1e-9])
+        W = W[keep]
+        if len(W) < 2:
+            W = np.vstack([W, W])
+            seg = np.array([1.0])
+        else:
+            seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
+        knots = np.concatenate([[0.0], np.cumsum(seg)])
+        knots /= knots[-1]
+        self.waypoints = W
+        self.spline = CubicSpline(knots, W, axis=0, bc_type="not-a-knot" if len(W) > 3 else "natural")
+        if len(W) == 2:  # a straight segment: linear in s
+            self.spline = CubicSpline(knots, W, axis=0, bc_type=((1, W[1] - W[0]), (1, W[1] - W[0])))
+        s = np.linspace(0.0, 1.0, SAMPLES)
+        d1 = np.abs(self.spline(s, 1)).max(axis=0)
+        d2 = np.abs(self.spline(s, 2)).max(axis=0)
+        t_vel = PEAK_SPEED * np.max(d1 / limits.velocity)
+        t_acc = np.sqrt(np.max((d2 * PEAK_SPEED**2 + d1 * PEAK_ACCEL) / limits.acceleration))
+        self.duration = float(max(t_vel, t_acc, min_duration))
+
+    def _eval(self, t):
+        T = self.duration
+        tau = np.clip(t / T, 0.0, 1.0)
+        s = tau**3 * (10 - 15 * tau + 6 * tau**2)
+        sd = 30 * tau**2 * (1 - tau) ** 2 / T
+        sdd = 60 * tau * (1 - tau) * (1 - 2 * tau) / T**2
+        q = self.spline(s)
+        d1 = self.spline(s, 1)
+        d2 = self.spline(s, 2)
+        return q, d1 * sd[:, None], d2 * sd[:, None] ** 2 + d1 * sdd[:, None]

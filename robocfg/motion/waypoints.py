@@ -1,0 +1,128 @@
+"""Task waypoints → joint-space waypoints (arm-joint order), with located errors.
+
+Forms (``trajectory.waypoints[i]`` in the task YAML):
+
+* ``home`` — the arm's home;
+* a list of values in arm-joint order (rad or m);
+* a ``{joint: value}`` map — joints it does not name keep the previous waypoint's value
+  (home's for the first waypoint);
+* a Cartesian TCP pose ``{position, euler_deg | quat_xyzw | quat_wxyz}`` in the world frame — solved
+  by IK seeded with the previous waypoint's joint values, so consecutive solutions stay on one
+  branch (continuity).
+
+Every joint-space waypoint must lie within the joint limits (ConfigError naming the waypoint index
+and the joint); an unreachable pose raises RunFailed naming the waypoint.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.config.suggest import did_you_mean
+from robocfg.config.types import Pose
+from robocfg.errors import ConfigError, Problem, RunFailed
+from robocfg.motion.limits import JointLimits
+
+LIMIT_TOL = 1e-9
+IK_POS_TOL = 1e-3  # m
+IK_ROT_TOL = 1e-2  # rad
+IK_JUMP_WARN = 1.5  # rad: an IK answer this far from the previous waypoint (one joint) earns a warning
+
+# problem(loc, message) -> Problem, loc relative to the waypoint list, e.g. (2, "panda_joint4")
+ProblemFn = Callable[[tuple, str], Problem]
+# ik(world_T_tcp 4x4, seed q) -> an IKResult-like object (q, converged, pos_err, rot_err)
+IKFn = Callable[[np.ndarray, np.ndarray], object]
+
+
+@dataclass
+class Waypoints:
+    """Joint-space waypoints (k, n) and what each came from ('home', 'list', 'map', 'pose')."""
+
+    q: np.ndarray
+    kinds: list[str]
+    ik_errors: dict[int, tuple[float, float]]  # waypoint → (position m, rotation rad) residual
+    warnings: list[str]
+
+
+def pose_matrix(pose: Pose) -> np.ndarray:
+    """world_T_tcp (4x4) of a task Pose."""
+    from robocfg.sim.frames import pose_to_matrix
+
+    return pose_to_matrix(pose.position, pose.quaternion_xyzw())
+
+
+def resolve_waypoints(items: list, limits: JointLimits, home: np.ndarray, problem: ProblemFn,
+                      ik: IKFn | None = None) -> Waypoints:
+    """Turn the task's waypoint entries into joint values. See the module docstring."""
+    names = list(limits.names)
+    problems: list[Problem] = []
+    rows: list[np.ndarray] = []
+    kinds: list[str] = []
+    ik_errors: dict[int, tuple[float, float]] = {}
+    warnings: list[str] = []
+    prev = np.asarray(home, dtype=float)
+    for i, item in enumerate(items):
+        q: np.ndarray | None = None
+        if isinstance(item, str):
+            kinds.append("home")
+            if item == "home":
+                q = np.asarray(home, dtype=float).copy()
+            else:
+                problems.append(problem((i,), f"unknown waypoint name {item!r}{did_you_mean(item, ['home'])} "
+                                              "(the only named waypoint is 'home')"))
+        elif isinstance(item, Pose):
+            kinds.append("pose")
+            if ik is None:
+                problems.append(problem((i,), "Cartesian waypoints need a kinematic model (none available)"))
+            elif not problems:
+                res = ik(pose_matrix(item), prev)
+                ok = bool(res.converged) and res.pos_err <= IK_POS_TOL and res.rot_err <= IK_ROT_TOL  # type: ignore[attr-defined]
+                if not ok:
+                    raise RunFailed("waypoints", f"waypoint {i} (TCP pose at {list(item.position)} m) is unreachable: "
+                                    f"IK residual {res.pos_err * 1000:.1f} mm, {np.degrees(res.rot_err):.1f}°")  # type: ignore[attr-defined]
+                q = np.asarray(res.q, dtype=float)  # type: ignore[attr-defined]
+                jump = np.abs(q - prev)
+                if jump.max() > IK_JUMP_WARN:
+                    k = int(np.argmax(jump))
+                    warnings.append(f"waypoint {i}: the IK answer moves {limits.names[k]} by {jump[k]:.2f} rad from the "
+                                    "previous waypoint (another IK branch?); add an intermediate waypoint if that is not intended")
+                ik_errors[i] = (float(res.pos_err), float(res.rot_err))  # type: ignore[attr-defined]
+        elif isinstance(item, dict):
+            kinds.append("map")
+            q = prev.copy()
+            for jn, v in item.items():
+                if jn not in names:
+                    problems.append(problem((i, jn), f"{jn!r} is not an arm joint{did_you_mean(jn, names)} (arm joints: {', '.join(names)})"))
+                    q = None
+                    break
+                q[names.index(jn)] = float(v)
+        else:
+            kinds.append("list")
+            if len(item) != len(names):
+                problems.append(problem((i,), f"waypoint {i} has {len(item)} values for {len(names)} arm joints ({', '.join(names)})"))
+            else:
+                q = np.asarray(item, dtype=float)
+        if q is None:
+            continue
+        given = set(item) if isinstance(item, dict) else None  # a map's other joints were checked before
+        _check_limits(i, q, limits, kinds[-1], problem, problems, given)
+        rows.append(q)
+        prev = q
+    if problems:
+        raise ConfigError(problems)
+    return Waypoints(np.array(rows), kinds, ik_errors, warnings)
+
+
+def _check_limits(i: int, q: np.ndarray, limits: JointLimits, kind: str, problem: ProblemFn,
+                  problems: list[Problem], only: set[str] | None = None) -> None:
+    bounded = limits.bounded()
+    for k, (jn, v) in enumerate(zip(limits.names, q, strict=True)):
+        if not bounded[k] or (only is not None and jn not in only):
+            continue
+        lo, hi = limits.lower[k], limits.upper[k]
+        if v < lo - LIMIT_TOL or v > hi + LIMIT_TOL:
+            loc = (i, jn) if kind == "map" else ((i, k) if kind == "list" else (i,))
+            problems.append(problem(loc, f"waypoint {i}: {jn} = {v:.4f} is outside its limits [{lo:.4f}, {hi:.4f}]"))

@@ -1,0 +1,178 @@
+"""``run trajectory``: a time-optimal joint trajectory through waypoints, tracked in PyBullet.
+
+Steps: ``waypoints`` (resolve the task's entries to joint values, IK for Cartesian poses, check
+joint limits) → ``planning`` (:func:`robocfg.motion.plan.plan_trajectory`: toppra along a spline,
+or trapezoids stopping at every waypoint, or ruckig with a jerk limit) → ``check`` (resample at
+1 kHz, count limit violations) → ``follow`` (the arm starts at the first waypoint; one command per
+physics step; tracking error per joint). The result is plain data (JSON-ready) plus the sampled
+trajectory (t, q, q̇, q̈) at ``sample_rate``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robocfg.checks.task import CheckedTask
+from robocfg.config.commands import TrajectoryParams
+from robocfg.errors import RunFailed
+
+CHECK_RATE = 1000.0  # Hz: resampling rate of the limit check
+
+
+@dataclass
+class Samples:
+    """The planned trajectory sampled at ``rate`` Hz: t (s), q (rad), qd (rad/s), qdd (rad/s²)."""
+
+    rate: float
+    t: list[float]
+    q: list[list[float]]
+    qd: list[list[float]]
+    qdd: list[list[float]]
+
+
+@dataclass
+class TrajectoryResult:
+    task: str
+    robot: str
+    arm: str
+    joint_names: list[str]
+    method: str  # toppra | trapezoid | ruckig | hold
+    path: str  # spline | pchip | linear | none
+    stop_at_waypoints: bool
+    duration: float  # s
+    planning_time_ms: float
+    gridpoints: int | None
+    fit_factor: float
+    waypoints: list[list[float]]  # distinct waypoints used (rad)
+    waypoint_indices: list[int]  # their indices in the task's list
+    waypoint_kinds: list[str]
+    waypoint_times: list[float]  # s
+    limits: dict  # lower, upper, velocity, acceleration, jerk (per joint)
+    limit_check: dict  # violations at 1 kHz and peak ratios
+    tracking: dict | None = None  # rms/max/final/settled per joint and overall (rad)
+    samples: Samples | None = None
+    measured: dict | None = None  # simulated t (s) and q (rad) at every physics step
+    warnings: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    success: bool = False
+    sim_time: float = 0.0
+    wall_time: float = 0.0
+    record: str | None = None
+    plot: str | None = None
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def _rounded(a: np.ndarray) -> list:
+    """Plain lists for JSON, rounded to 1e-9 (shorter files, far below any error reported)."""
+    return np.round(np.asarray(a, dtype=float), 9).tolist()
+
+
+def plan_task(task: CheckedTask):
+    """Resolve the task's waypoints and plan. Returns (params, arm config, joint names, limits,
+    Waypoints, Plan). Raises ConfigError (bad waypoints/limits) or RunFailed (unreachable pose)."""
+    from robocfg.motion.limits import limits_from_robot
+    from robocfg.motion.plan import plan_trajectory
+    from robocfg.motion.waypoints import resolve_waypoints
+
+    params: TrajectoryParams = task.config.trajectory  # type: ignore[union-attr]
+    robot = task.robots[0]
+    arm = robot.config.arm(params.arm)
+    names = robot.arm_joints(arm)
+    limits = limits_from_robot(robot, names, params.limits)
+    home = np.asarray(arm.home, dtype=float)
+
+    def problem(loc: tuple, msg: str):
+        return task.doc.problem(("trajectory", "waypoints", *loc), msg)
+
+    wps = resolve_waypoints(list(params.waypoints), limits, home, problem, ik=_ik_fn(task, arm.name, params))
+    plan = plan_trajectory(wps.q, limits, params.stop_at_waypoints, params.gridpoints)
+    return params, arm, names, limits, wps, plan
+
+
+def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
+    from robocfg.config.types import Pose
+
+    if not any(isinstance(w, Pose) for w in params.waypoints):
+        return None
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.sim.frames import pose_to_matrix
+
+    mount = task.config.robots[0]
+    model = KinematicModel.from_robot(task.robots[0], arm_name, base_pose=pose_to_matrix(mount.position, mount.quaternion_xyzw()))
+    return lambda target, seed: model.ik(target, seed_q=seed, frame="tcp")
+
+
+def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = None,
+                   follow: bool = True, fps: float = 15.0) -> TrajectoryResult:
+    """Plan and (if ``follow``) track the task's trajectory. Raises ConfigError for bad input,
+    RunFailed (with the result so far) if a phase fails."""
+    from robocfg.motion.trajectory import check_limits
+
+    t_wall = time.perf_counter()
+    params, arm, names, limits, wps, plan = plan_task(task)
+    check = check_limits(plan.trajectory, limits, CHECK_RATE)
+    s = plan.trajectory.sample(params.sample_rate)
+    result = TrajectoryResult(
+        task=str(task.path), robot=task.robots[0].config.name, arm=arm.name, joint_names=list(names),
+        method=plan.method, path=plan.path, stop_at_waypoints=params.stop_at_waypoints,
+        duration=plan.duration, planning_time_ms=plan.planning_time * 1e3, gridpoints=plan.gridpoints,
+        fit_factor=plan.fit_factor, waypoints=plan.waypoints.tolist(), waypoint_indices=list(plan.waypoint_indices),
+        waypoint_kinds=[wps.kinds[i] for i in plan.waypoint_indices], waypoint_times=list(plan.waypoint_times),
+        limits={"lower": limits.lower.tolist(), "upper": limits.upper.tolist(), "velocity": limits.velocity.tolist(),
+                "acceleration": limits.acceleration.tolist(),
+                "jerk": None if limits.jerk is None else limits.jerk.tolist()},
+        limit_check=asdict(check) | {"total": check.total},
+        samples=Samples(params.sample_rate, *(_rounded(a) for a in (s.t, s.q, s.qd, s.qdd))),
+        warnings=[p.format() for p in task.warnings] + wps.warnings + list(plan.warnings), notes=list(plan.notes),
+    )
+    if wps.ik_errors:
+        result.warnings += [f"waypoint {i}: IK residual {p * 1000:.2f} mm, {np.degrees(r):.2f}°"
+                            for i, (p, r) in wps.ik_errors.items() if p > 1e-4 or r > 1e-3]
+    if not follow:
+        result.success = check.total == 0
+        result.wall_time = time.perf_counter() - t_wall
+        return result
+    _follow(task, params, names, plan, result, gui, record, fps)
+    result.wall_time = time.perf_counter() - t_wall
+    return result
+
+
+def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps) -> None:
+    from robocfg.motion.follower import follow
+    from robocfg.sim.record import CameraView, Recorder
+    from robocfg.sim.world import World
+
+    with World(task, gui=gui) as world:
+        result.warnings += list(world.warnings)
+        robot = world.robot
+        robot.reset_joints(names, plan.waypoints[0])
+        robot.command_positions(names, plan.waypoints[0])
+        recorder = None
+        if record is not None:
+            base = robot.base_pose()[:3, 3]
+            view = CameraView(target=(float(base[0]) + 0.3, float(base[1]), float(base[2]) + 0.4), distance=1.5)
+            recorder = Recorder(world, record, fps=fps, camera=view)
+            recorder.capture()
+        try:
+            tr = follow(world, names, plan.trajectory, params.settle_time,
+                        on_step=recorder.maybe_capture if recorder is not None else None)
+        except RunFailed as exc:
+            raise RunFailed(exc.phase, exc.reason, report=result) from None
+        finally:
+            result.sim_time = world.t
+            if recorder is not None:
+                result.record = str(recorder.save())
+        result.tracking = {
+            "rms": tr.rms, "max": tr.max, "final": tr.final, "settled": tr.settled,
+            "rms_per_joint": tr.rms_error, "max_per_joint": tr.max_error,
+            "final_per_joint": tr.final_error, "settled_per_joint": tr.settled_error,
+            "steps": tr.steps, "dt": world.dt, "settle_time": tr.settle_time,
+        }
+        result.measured = {"t": _rounded(tr.t), "q": _rounded(tr.q)}
+        result.success = result.limit_check["total"] == 0
