@@ -32,6 +32,8 @@ Log = Callable[[str], None]
 CARTESIAN_STEP = 0.03  # m between IK waypoints on straight TCP lines
 SETTLE_POLL = 4  # physics steps between convergence checks
 RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
+MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
+SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
 
 
 class PhaseFailed(Exception):
@@ -159,7 +161,10 @@ class _StateMachine:
         self._settle(0.2)
         obj_pos, _ = self.world.body_pose(self.obj)
         self.support_z = obj_pos[2] - self.setup.body.half_height()
-        center = obj_pos + np.array([0, 0, p.grasp_depth])
+        if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
+            center = obj_pos + np.array([0, 0, self.setup.body.half_height() - SUCTION_PRESS])
+        else:
+            center = obj_pos + np.array([0, 0, p.grasp_depth])
         grasp = self._choose_grasp(center)
         T_grasp = ee_pose_from_grasp(grasp, self.cfg)
         T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
@@ -220,21 +225,33 @@ class _StateMachine:
 
     # ---- motion ------------------------------------------------------------------------------
     def _choose_grasp(self, center: np.ndarray) -> Grasp:
+        """Of the two top-down grasps, the one whose pre-grasp IK answer needs the least joint
+        travel (largest |Δq|, rad) from the current joints; the smaller wrist turn breaks ties. (IK
+        from the current joints can land on a far branch, e.g. a Panda's shoulder flipped by
+        ≈ 3 rad, for one of the two grasps only.)"""
         b = self.setup.body
         extent = (b.size[0], b.size[1]) if b.shape in ("box", "mesh") else (2 * b.size[0], 2 * b.size[0])
         R_now = self.arm.ee_pose()[:3, :3]
-        cands = top_down_grasps(center, self.setup.yaw, extent)
-        return min(cands, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+        cands = sorted(top_down_grasps(center, self.setup.yaw, extent),
+                       key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+        q0 = self.arm.joint_positions()
+
+        def travel(g: Grasp) -> float:
+            T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
+            res = self.model.ik(T_pre, seed_q=q0, frame="ee", time_budget=0.05)
+            return float(np.max(np.abs(res.q - q0))) if res.converged else math.inf
+
+        costs = [travel(g) for g in cands]
+        return cands[int(np.argmin(costs))] if min(costs) < math.inf else cands[0]
 
     def _solve(self, T: np.ndarray, seed: np.ndarray, what: str) -> np.ndarray:
         res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=0.05)
         if not res.converged:
-            raise PhaseFailed(self.phase, f"{what} unreachable (IK residual {res.pos_err * 1000:.1f} mm, {math.degrees(res.rot_err):.1f}°)")
+            raise PhaseFailed(self.phase, f"unreachable{what} (residual {res.pos_err * 1000:.1f} mm, {math.degrees(res.rot_err):.1f}°)")
         return res.q
 
     def _move(self, T_goal: np.ndarray, straight: bool, check_held: bool = False) -> None:
-        from robocfg.motion.follower import follow
-        from robocfg.motion.plan import plan_trajectory
+        from robocfg.motion.minjerk_path import MinJerkPath
 
         q0 = self.arm.joint_positions()
         T0 = self.model.fk(q0, "ee")
@@ -244,21 +261,36 @@ class _StateMachine:
             for s in np.linspace(0, 1, n)[1:]:
                 T = T_goal.copy()
                 T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
-                q = self._solve(T, q, "target")
+                q_next = self._solve(T, q, f" at {s:.0%} of the straight line")
+                if np.max(np.abs(q_next - q)) > MAX_JOINT_JUMP:
+                    raise PhaseFailed(self.phase, f"no continuous IK along the straight line (a joint jumps "
+                                                  f"{np.max(np.abs(q_next - q)):.2f} rad at {s:.0%})")
+                q = q_next
                 waypoints.append(q)
         else:
-            waypoints = [q0, self._solve(T_goal, q0, "target")]
+            waypoints = [q0, self._solve(T_goal, q0, "")]
         W = np.asarray(waypoints)
         if np.max(np.abs(W[-1] - W[0])) < 1e-6:
             return
-        plan = plan_trajectory(W, self.limits)
-        if plan.duration > self.timeout():
-            raise PhaseFailed(self.phase, f"motion needs {plan.duration:.2f} s, more than the {self.timeout():.2f} s timeout")
+        traj = MinJerkPath(W, self.limits)
+        if traj.duration > self.timeout():
+            raise PhaseFailed(self.phase, f"motion needs {traj.duration:.2f} s, more than the {self.timeout():.2f} s timeout")
         t_start = self.world.t
-        follow(self.world, self.arm.joints, plan.trajectory, settle_time=0.0, on_step=self._on_step)
+        self._play(traj)
         self._converge(T_goal, t_start)
         if check_held and not self._held():
             raise PhaseFailed(self.phase, f"object dropped ({self._object_to_tcp() * 100:.1f} cm from the TCP)")
+
+    def _play(self, traj) -> None:
+        """Send the trajectory's position and velocity targets every physics step (no tracking
+        statistics: the per-step cost stays at one motor call)."""
+        dt = self.world.dt
+        n = math.ceil(traj.duration / dt - 1e-9)
+        q_ref, qd_ref, _ = traj.evaluate(np.arange(1, n + 1) * dt)
+        for k in range(n):
+            self.arm.command(q_ref[k], qd_ref[k])
+            self.world.step()
+            self._on_step()
 
     def _converge(self, T_goal: np.ndarray, t_start: float) -> None:
         p = self.params
@@ -274,36 +306,31 @@ class _StateMachine:
 
     # ---- gripper -----------------------------------------------------------------------------
     def _open_gripper(self) -> None:
-        if self.cfg.gripper.type == "suction":
-            self.gripper.off()
-        else:
-            self.gripper.open()
+        self.gripper.open()
 
     def _grasp(self) -> None:
+        """Close; wait until the object is held and a measured finger width (if any) is still."""
         t0 = self.world.t
-        if self.cfg.gripper.type == "suction":
-            self.gripper.on()
-            while not self.gripper.is_grasping(self.obj):
-                if self.world.t - t0 > self.timeout():
-                    raise PhaseFailed("grasp", "suction did not attach")
-                self._step(SETTLE_POLL)
-            return
         self.gripper.close()
-        last, still = self.gripper.width(), 0.0
-        while still < 0.1:
+        measure = getattr(self.gripper, "width", None)
+        last, still = (measure() if measure else 0.0), 0.0
+        while not (self._held() and (measure is None or still >= 0.1)):
             self._step(SETTLE_POLL)
-            w = self.gripper.width()
-            still = still + SETTLE_POLL * self.world.dt if abs(w - last) < 2e-4 else 0.0
-            last = w
+            if measure is not None:
+                w = measure()
+                still = still + SETTLE_POLL * self.world.dt if abs(w - last) < 2e-4 else 0.0
+                last = w
             if self.world.t - t0 > self.timeout():
-                break
-        if not self.gripper.is_grasping(self.obj):
-            raise PhaseFailed("grasp", f"no contact on both fingers (width {self.gripper.width() * 1000:.1f} mm)")
+                if self._held():
+                    return
+                width = f" (width {measure() * 1000:.1f} mm)" if measure else ""
+                raise PhaseFailed("grasp", f"the object is not held{width}")
 
     def _release(self) -> None:
         t0 = self.world.t
         self._open_gripper()
-        while self.gripper.is_grasping(self.obj) or (self.cfg.gripper.type == "parallel" and self.gripper.fraction() < 0.9):
+        opening = getattr(self.gripper, "fraction", None)
+        while self._held() or (opening is not None and opening() < 0.9):
             if self.world.t - t0 > self.timeout():
                 raise PhaseFailed("release", "the object did not come free")
             self._step(SETTLE_POLL)

@@ -1,0 +1,5 @@
+"""``python -m robocfg`` = the ``robocfg`` command."""
+
+from robocfg.cli.app import main
+
+main()
