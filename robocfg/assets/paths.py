@@ -28,6 +28,9 @@ def _package_root(module: str) -> Path | None:
     return Path(next(iter(spec.submodule_search_locations)))
 
 
+_MESH_HITS: dict[tuple, Path] = {}
+
+
 @dataclass(frozen=True)
 class Resolver:
     """Resolves URIs relative to ``base_dir`` (the YAML's folder) with a ``package_dirs`` map."""
@@ -57,7 +60,19 @@ class Resolver:
         return _exists(uri, [p if p.is_absolute() else self.base_dir / p])
 
     def mesh(self, filename: str, urdf_path: Path) -> Path:
-        """An existing mesh file referenced from ``urdf_path``, or UnresolvedPath listing what was tried."""
+        """An existing mesh file referenced from ``urdf_path``, or UnresolvedPath listing what was tried.
+
+        Hits are remembered per process (re-checked with one ``is_file``): a robot's meshes are
+        looked up by several checks, and each miss-free lookup costs a few path resolutions."""
+        key = (filename, urdf_path, self.base_dir, tuple(sorted((self.package_dirs or {}).items())))
+        hit = _MESH_HITS.get(key)
+        if hit is not None and hit.is_file():
+            return hit
+        found = self._mesh(filename, urdf_path)
+        _MESH_HITS[key] = found
+        return found
+
+    def _mesh(self, filename: str, urdf_path: Path) -> Path:
         urdf_dir = urdf_path.parent
         if filename.startswith("file://"):
             filename = filename[len("file://") :]

@@ -190,15 +190,32 @@ def _geometry(el: ET.Element) -> Geometry | None:
     return None
 
 
+def read_urdf_xml(path: Path | str) -> ET.Element:
+    """The URDF's root element. Namespace prefixes used without a declaration (airo-models'
+    UR URDFs write ``drake:acceleration``; urdfdom, PyBullet and pinocchio accept it) are declared
+    before parsing. Raises ET.ParseError / OSError."""
+    import re
+
+    data = Path(path).read_bytes()
+    try:
+        return ET.fromstring(data)
+    except ET.ParseError as exc:
+        if "unbound prefix" not in str(exc):
+            raise
+        found = re.findall(rb"(?:[\s<]|</)([A-Za-z_][\w.-]*):[A-Za-z_]", data)
+        prefixes = sorted({p.decode() for p in found} - {"xmlns", "xml"})
+        decl = "".join(f' xmlns:{px}="urn:robocfg:undeclared:{px}"' for px in prefixes).encode()
+        return ET.fromstring(re.sub(rb"<robot\b", b"<robot" + decl, data, count=1))
+
+
 def parse_urdf(path: Path) -> Urdf:
     """Parse a URDF file. Raises UrdfParseError with a line number when the XML is broken."""
     try:
-        tree = ET.parse(path)
+        root = read_urdf_xml(path)
     except ET.ParseError as exc:
         raise UrdfParseError(f"broken XML: {exc}", exc.position[0] if exc.position else None) from None
     except OSError as exc:
         raise UrdfParseError(f"cannot read: {exc}") from None
-    root = tree.getroot()
     if root.tag != "robot":
         raise UrdfParseError(f"top element is <{root.tag}>, expected <robot>", 1)
     try:

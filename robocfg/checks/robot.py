@@ -5,12 +5,13 @@ Errors stop the robot from being used; warnings are reported (``--strict`` makes
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import hashlib
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from robocfg.assets.meshes import geometry_points
+from robocfg.assets.fingers import FingerGeometryMissing, finger_points, pad_midpoint, pad_points
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import Urdf, UrdfParseError, parse_urdf
 from robocfg.config.load import Loc, YamlDocument, load_yaml, validate_document
@@ -22,7 +23,7 @@ from robocfg.errors import ConfigError, Problem
 ROT_TOL = 1e-6
 TCP_WARN_DIST = 0.010  # m
 TCP_WARN_ANGLE_DEG = 10.0
-PAD_LENGTH = 0.02  # m: the distal part of a finger counted as its pad
+TCP_ERROR_ANGLE_DEG = 45.0  # past this, ee_axis does not point at the fingers at all: an error
 
 
 @dataclass
@@ -34,6 +35,7 @@ class CheckedRobot:
     urdf_path: Path
     urdf: Urdf
     warnings: list[Problem] = field(default_factory=list)
+    sources: tuple[Path, ...] = ()  # the URDFs composed into urdf_path (robot + attachments), if any
 
     @property
     def path(self) -> Path:
@@ -68,8 +70,45 @@ class _Collector:
         self.problems.append(self.doc.problem(loc, msg, "warning"))
 
 
+_CACHE: dict[tuple, tuple[CheckedRobot, tuple]] = {}
+_CACHE_SIZE = 32
+
+
 def load_robot(path: str | Path, strict: bool = False) -> CheckedRobot:
-    """Load and check a robot YAML. Raises ConfigError listing every error (and, if strict, warning)."""
+    """Load and check a robot YAML. Raises ConfigError listing every error (and, if strict, warning).
+
+    Valid robots are memoised per process, keyed on the YAML's path and content and checked
+    against the URDF's size and mtime, so validating many tasks that name the same robot parses
+    its URDF and meshes once. Each call gets its own ``CheckedRobot`` and warnings list."""
+    p = Path(path)
+    try:
+        key: tuple | None = (p.resolve(), hashlib.sha1(p.read_bytes()).hexdigest(), strict)
+    except OSError:
+        key = None
+    hit = _CACHE.get(key) if key is not None else None
+    if hit is not None and _stat_key(hit[0].urdf_path, *hit[0].sources) == hit[1]:
+        robot = hit[0]
+    else:
+        robot = _load_robot(p, strict)
+        if key is not None:
+            if len(_CACHE) >= _CACHE_SIZE:
+                _CACHE.pop(next(iter(_CACHE)))
+            _CACHE[key] = (robot, _stat_key(robot.urdf_path, *robot.sources))
+    return replace(robot, warnings=list(robot.warnings))
+
+
+def _stat_key(*paths: Path) -> tuple:
+    out: tuple = ()
+    for path in paths:
+        try:
+            st = path.stat()
+        except OSError:
+            return ()
+        out += (st.st_size, st.st_mtime_ns)
+    return out
+
+
+def _load_robot(path: Path, strict: bool) -> CheckedRobot:
     doc = load_yaml(path)
     config: RobotConfig = validate_document(doc, RobotConfig)
     c = _Collector(doc)
@@ -78,12 +117,17 @@ def load_robot(path: str | Path, strict: bool = False) -> CheckedRobot:
         urdf_path = resolver.urdf(config.urdf)
     except UnresolvedPath as exc:
         raise ConfigError([doc.problem(("urdf",), f"URDF not found: {exc}")]) from None
+    sources: tuple[Path, ...] = ()
+    if config.attachments:
+        composed = _compose(doc, config, resolver, urdf_path)  # ConfigError for a missing attachment
+        sources = (urdf_path, *(resolver.urdf(a.urdf) for a in config.attachments))
+        urdf_path = composed
     try:
         urdf = parse_urdf(urdf_path)
     except UrdfParseError as exc:
         line = f":{exc.line}" if exc.line else ""
         raise ConfigError([doc.problem(("urdf",), f"URDF {urdf_path}{line} does not parse: {exc}")]) from None
-    robot = CheckedRobot(config, doc, urdf_path, urdf)
+    robot = CheckedRobot(config, doc, urdf_path, urdf, sources=sources)
     _check_meshes(c, robot, resolver)
     for i, arm in enumerate(config.arms):
         _check_arm(c, robot, arm, ("arms", i), resolver)
@@ -94,6 +138,29 @@ def load_robot(path: str | Path, strict: bool = False) -> CheckedRobot:
         raise ConfigError(errors + (warnings if strict else []))
     robot.warnings = warnings
     return robot
+
+
+def _compose(doc: YamlDocument, config: RobotConfig, resolver: Resolver, base: Path) -> Path:
+    """Compose the URDF with ``attachments`` (cached file); ConfigError at the attachment's lines."""
+    from robocfg.assets.compose import CompositionError, Part, compose, rpy_from_deg
+
+    parts, problems = [], []
+    for i, a in enumerate(config.attachments):
+        try:
+            path = resolver.urdf(a.urdf)
+        except UnresolvedPath as exc:
+            problems.append(doc.problem(("attachments", i, "urdf"), f"URDF not found: {exc}"))
+            continue
+        parts.append((i, Part(path, a.mount_link, tuple(a.mount_xyz), rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix)))
+    if problems:
+        raise ConfigError(problems)
+    try:
+        return compose(base, [part for _, part in parts], resolver).path
+    except CompositionError as exc:
+        raise ConfigError([doc.problem(("urdf",) if pr.index is None else ("attachments", parts[pr.index][0], pr.key),
+                                       pr.message) for pr in exc.problems]) from None
+    except OSError as exc:
+        raise ConfigError([doc.problem(("attachments",), f"cannot write the composed URDF: {exc}")]) from None
 
 
 def _check_meshes(c: _Collector, robot: CheckedRobot, resolver: Resolver) -> None:
@@ -132,7 +199,7 @@ def _check_arm(c: _Collector, robot: CheckedRobot, arm: ArmConfig, loc: Loc, res
             movable = [j.name for j in chain if j.movable]
             if movable != arm_joints:
                 c.error((*loc, "joints" if arm.joints else "joint_indices"),
-                        f"arm joints must be the movable joints from base_link to ee_link in order: {movable}, got {arm_joints}")
+                        f"arm joints must form the serial chain of movable joints from base_link {arm.base_link!r} to ee_link {arm.ee_link!r}, in order: expected {movable}, got {arm_joints}")
     # R_ee_graspnet
     R = np.asarray(arm.R_ee_graspnet, dtype=float)
     if not np.allclose(R @ R.T, np.eye(3), atol=ROT_TOL) or abs(np.linalg.det(R) - 1) > ROT_TOL:
@@ -180,13 +247,23 @@ def _check_joint_list(c: _Collector, urdf: Urdf, names: list[str] | None, indice
         ndof = len(urdf.dof_joints)
         for k, i in enumerate(indices):
             if not 0 <= i < ndof:
-                fixed = [j.name for j in urdf.joints.values() if not j.movable]
-                c.error((*loc, index_key, k), f"DOF index {i} is out of range: the URDF has {ndof} movable joints (0..{ndof - 1}); fixed joints such as {fixed[:3]} have no DOF index")
+                c.error((*loc, index_key, k), f"DOF index {i} is out of range: the URDF has {ndof} movable joints (0..{ndof - 1}){_pybullet_hint(urdf, i)}")
                 ok = False
             elif names is not None and k < len(names) and urdf.dof_joints[i] != names[k]:
-                c.error((*loc, index_key, k), f"DOF index {i} is {urdf.dof_joints[i]!r} but {name_key}[{k}] is {names[k]!r}")
+                c.error((*loc, index_key, k), f"DOF index {i} is {urdf.dof_joints[i]!r} but {name_key}[{k}] is {names[k]!r}{_pybullet_hint(urdf, i)}")
                 ok = False
     return ok
+
+
+def _pybullet_hint(urdf: Urdf, i: int) -> str:
+    """Hint for the classic mistake of giving a PyBullet joint index (fixed joints counted)."""
+    by_index = {j.urdf_index: j for j in urdf.joints.values()}
+    j = by_index.get(i)
+    if j is None:
+        return ""
+    if j.movable:
+        return f"; PyBullet joint index {i} is {j.name!r}, whose DOF index is {urdf.dof_index(j.name)} (indices here are DOF indices, see `robocfg inspect`)"
+    return f"; PyBullet joint index {i} is the {j.type} joint {j.name!r} (indices here are DOF indices: fixed joints have none, see `robocfg inspect`)"
 
 
 def _check_parallel(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGripperConfig,
@@ -196,12 +273,15 @@ def _check_parallel(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: Paral
         return
     leaders = robot.gripper_joints(arm)
     arm_joints = set(robot.arm_joints(arm)) if (arm.joints or arm.joint_indices) else set()
+    key = "joints" if g.joints is not None else "gripper_indices"
     for k, jn in enumerate(leaders):
         j = urdf.joints[jn]
         if jn in arm_joints:
-            c.error((*loc, "joints", k), f"gripper joint {jn!r} is also an arm joint")
+            c.error((*loc, key, k), f"gripper joint {jn!r} is also an arm joint")
         if arm.ee_link in urdf.descendants(jn):
-            c.error((*loc, "joints", k), f"gripper joint {jn!r} moves ee_link {arm.ee_link!r}: the EE→TCP transform must be fixed; pick a link above the fingers")
+            c.error((*loc, key, k), f"gripper joint {jn!r} moves ee_link {arm.ee_link!r}: the EE→TCP transform must be fixed; pick a link above the fingers")
+        if j.mimic is not None:
+            c.error((*loc, key, k), f"gripper joint {jn!r} is a mimic follower of {j.mimic.joint!r} (URDF <mimic>); list only the driven joint(s) — followers are geared automatically")
         for key in ("open", "closed"):
             v = getattr(g, key)[k]
             if not (j.lower - 1e-9 <= v <= j.upper + 1e-9):
@@ -213,41 +293,30 @@ def _check_parallel(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: Paral
 
 def _check_tcp(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGripperConfig,
                leaders: list[str], loc: Loc, resolver: Resolver) -> None:
-    """The finger-pad midpoint (gripper open, by FK) must lie along +ee_axis at ≈ tcp_offset."""
+    """The finger-pad midpoint (by FK) must lie along +ee_axis, and ``tcp_offset`` within the range
+    that midpoint covers between ``open`` and ``closed`` (± TCP_WARN_DIST): on linkage grippers
+    (Robotiq) the pads move along the approach axis as they close, so the TCP depends on the width."""
     urdf = robot.urdf
-    q = dict(zip(leaders, g.open, strict=True))
-    T_ee_inv = np.linalg.inv(urdf.link_pose(arm.ee_link, q))
     axis = AXIS_INDEX[arm.ee_axis]
-    pads = []
-    for fl in g.finger_links:
-        link = urdf.links[fl]
-        geoms = link.collisions or link.visuals
-        pts = []
-        for geom in geoms:
-            mesh = None
-            if geom.kind == "mesh":
-                try:
-                    mesh = resolver.mesh(geom.filename or "", robot.urdf_path)
-                except UnresolvedPath:
-                    return  # already reported
-            pts.append(geometry_points(geom, mesh))
-        if not pts or not len(np.concatenate(pts)):
-            c.warn((*loc, "finger_links"), f"finger link {fl!r} has no geometry; cannot check tcp_offset")
-            return
-        P = np.concatenate(pts)
-        T = T_ee_inv @ urdf.link_pose(fl, q)
-        P_ee = P @ T[:3, :3].T + T[:3, 3]
-        tip = P_ee[:, axis].max()
-        pad = P_ee[P_ee[:, axis] >= tip - PAD_LENGTH]
-        pads.append((pad.min(axis=0) + pad.max(axis=0)) / 2)
-    mid = (pads[0] + pads[1]) / 2
+    try:
+        points = finger_points(urdf, resolver, list(g.finger_links))
+    except FingerGeometryMissing as exc:
+        if "no geometry" in str(exc):
+            c.warn((*loc, "finger_links"), f"{exc}; cannot check tcp_offset")
+        return  # a missing mesh is already reported
+    mids = [pad_midpoint(pad_points(urdf, arm.ee_link, list(g.finger_links), points, dict(zip(leaders, qs, strict=True)), axis))
+            for qs in (g.open, g.closed)]
+    mid = mids[0]
     along = mid[axis]
     angle = np.degrees(np.arccos(np.clip(along / max(np.linalg.norm(mid), 1e-9), -1, 1)))
+    lo, hi = sorted(float(m[axis]) for m in mids)
     tcp_loc = ("arms", robot.config.arms.index(arm), "tcp_offset")
-    if along <= 0:
-        c.error(tcp_loc, f"the finger pads are on the −{arm.ee_axis} side of ee_link; ee_axis must point from ee_link towards the fingertips")
-    elif abs(along - arm.tcp_offset) > TCP_WARN_DIST or angle > TCP_WARN_ANGLE_DEG:
-        c.warn(tcp_loc, f"finger-pad midpoint (gripper open) is {along:.4f} m along {arm.ee_axis} and {angle:.1f}° off the axis; tcp_offset is {arm.tcp_offset:.4f} m")
+    span = f"{along:.4f} m" if hi - lo < 1e-4 else f"{mids[0][axis]:.4f} m open, {mids[1][axis]:.4f} m closed"
+    if along <= 0 or angle > TCP_ERROR_ANGLE_DEG:
+        c.error((*loc[:-1], "ee_axis"), f"the finger pads (gripper open) are {angle:.0f}° away from +{arm.ee_axis} of ee_link "
+                f"(midpoint {np.round(mid, 4).tolist()} m in the ee_link frame); ee_axis must point from ee_link towards the fingertips")
+    elif not lo - TCP_WARN_DIST <= arm.tcp_offset <= hi + TCP_WARN_DIST or angle > TCP_WARN_ANGLE_DEG:
+        c.warn(tcp_loc, f"finger-pad midpoint is {span} along {arm.ee_axis} and {angle:.1f}° off the axis; tcp_offset is {arm.tcp_offset:.4f} m")
 
 
 def _check_drives_and_physics(c: _Collector, robot: CheckedRobot) -> None:

@@ -56,7 +56,8 @@ def load_task(path: str | Path, strict: bool = False, robot_override: str | None
             else:
                 rpath = (doc.path.parent / mount.robot_config_file).resolve()  # type: ignore[operator]
                 if not rpath.is_file():
-                    raise NotFound("robot file", str(mount.robot_config_file), [])
+                    problems.append(doc.problem(loc, f"robot file not found: {rpath}"))
+                    continue
             robots.append(load_robot(rpath, strict=strict))
         except NotFound as exc:
             problems.append(doc.problem(loc, str(exc)))
@@ -68,7 +69,8 @@ def load_task(path: str | Path, strict: bool = False, robot_override: str | None
         _check_pick_place(doc, config, robots[0], problems, warnings)
     if problems or (strict and warnings):
         raise ConfigError(problems + (warnings if strict else []))
-    return CheckedTask(config, doc, robots, warnings)
+    robot_warnings = [w for r in robots for w in r.warnings]  # with the robot file's own path
+    return CheckedTask(config, doc, robots, robot_warnings + warnings)
 
 
 def _check_pick_place(doc: YamlDocument, task: PickPlaceTask, robot: CheckedRobot,

@@ -7,7 +7,7 @@ import sys
 
 import typer
 
-from robocfg.cli import inspect_cmd, robots, run, schema, validate
+from robocfg.cli import bench, ik, inspect_cmd, new_robot, robots, run, schema, validate
 
 app = typer.Typer(
     name="robocfg",
@@ -15,6 +15,7 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode=None,  # plain help: rendering it with rich costs ~0.15 s of imports on every --help
     context_settings={"help_option_names": ["-h", "--help"]},
 )
 
@@ -36,8 +37,11 @@ def _root(
 app.command("validate")(validate.validate)
 app.command("robots")(robots.robots)
 app.command("inspect")(inspect_cmd.inspect)
+app.command("new-robot")(new_robot.new_robot)
 app.command("schema")(schema.schema)
 app.add_typer(run.run_app, name="run")
+app.command("ik")(ik.ik)
+app.add_typer(bench.bench_app, name="bench")
 
 
 def main() -> None:
@@ -55,15 +59,30 @@ def main() -> None:
     except SystemExit:
         raise
     except BaseException as exc:
-        import click
-
-        if isinstance(exc, click.exceptions.Abort):
+        abort, usage = _cli_exception_types()
+        if isinstance(exc, abort):
             sys.exit(130)
-        if isinstance(exc, click.ClickException):
-            exc.show()
-            sys.exit(2)
+        if isinstance(exc, usage):
+            exc.show()  # type: ignore[attr-defined]
+            code = getattr(exc, "exit_code", 2)
+            sys.exit(code if isinstance(code, int) and code != 1 else 2)
         if debug_enabled():
             raise
         code, message = describe(exc)
         print(message, file=sys.stderr)
         sys.exit(code)
+
+
+def _cli_exception_types() -> tuple[tuple[type, ...], tuple[type, ...]]:
+    """(abort, usage-error) exception classes: typer ≥ 0.16 vendors click as ``typer._click``;
+    older typer versions raise click's own classes."""
+    abort: list[type] = [typer.Abort]
+    usage: list[type] = [t for t in (getattr(typer, "TyperException", None),) if t is not None]
+    try:
+        import click
+    except ImportError:
+        pass
+    else:
+        abort.append(click.exceptions.Abort)
+        usage.append(click.ClickException)
+    return tuple(abort), tuple(usage)

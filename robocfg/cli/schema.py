@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import typing
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -13,13 +14,25 @@ def schema(
     kind: Annotated[str, typer.Argument(help="robot or task")],
     output: Annotated[Path | None, typer.Option("-o", "--output", help="Write to this file instead of stdout.")] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output file.")] = False,
+    markdown: Annotated[bool, typer.Option("--markdown", help="Field reference tables (Markdown) instead of JSON Schema; "
+                                           "with -o, replaces only the generated block of an existing document.")] = False,
 ) -> None:
     """Print the JSON Schema of robot or task YAMLs (for yaml-language-server)."""
     from robocfg.errors import NotFound
 
     if kind not in ("robot", "task"):
         raise NotFound("schema kind", kind, ["robot", "task"])
-    text = json.dumps(json_schema(kind), indent=2) + "\n"  # type: ignore[arg-type]
+    if markdown:
+        text = markdown_text(kind)  # type: ignore[arg-type]
+        if output is not None and output.exists():
+            from robocfg.cli.schema_markdown import replace_block
+
+            merged = replace_block(output.read_text(), text)
+            if merged is not None:
+                output.write_text(merged)
+                return
+    else:
+        text = json.dumps(json_schema(kind), indent=2) + "\n"  # type: ignore[arg-type]
     if output is None:
         typer.echo(text, nl=False)
         return
@@ -41,7 +54,22 @@ def json_schema(kind: Literal["robot", "task"]) -> dict:
     else:
         from robocfg.config.task import TaskConfig
 
-        out = TypeAdapter(TaskConfig).model_json_schema()
+        out = TypeAdapter(TaskConfig).json_schema()
     out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     out["title"] = f"robocfg {kind} YAML (schema_version 1)"
     return out
+
+
+def markdown_text(kind: Literal["robot", "task"]) -> str:
+    """Field tables for docs/KIND-yaml.md, from the models."""
+    from robocfg.cli.schema_markdown import markdown_reference
+
+    if kind == "robot":
+        from robocfg.config.robot import RobotConfig
+
+        roots: list = [RobotConfig]
+    else:
+        from robocfg.config.task import TaskConfig
+
+        roots = list(typing.get_args(typing.get_args(TaskConfig)[0]))  # the union's members
+    return markdown_reference(kind, json_schema(kind), roots)

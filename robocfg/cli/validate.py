@@ -14,7 +14,7 @@ def validate(
     paths: Annotated[list[Path] | None, typer.Argument(help="YAML files or directories; none = all built-ins.")] = None,
     strict: StrictOpt = False,
     json_path: JsonOpt = None,
-) -> int:
+) -> None:
     """Check robot and task YAMLs against their schema and URDFs. Exit 0 valid, 2 invalid."""
     from rich.table import Table
 
@@ -49,7 +49,8 @@ def validate(
                         "problems": [p.__dict__ for p in problems], "warnings": [w.__dict__ for w in warnings]})
     out.print(table)
     write_json(json_path, {"valid": not any_error, "files": records})
-    return 2 if any_error else 0
+    if any_error:
+        raise typer.Exit(2)
 
 
 def _collect(paths: list[Path]) -> list[Path]:

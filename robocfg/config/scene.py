@@ -15,8 +15,8 @@ class Body(Pose):
     """A primitive body. ``size`` means: box → full extents [x, y, z]; sphere → [radius];
     cylinder/capsule → [radius, length]; mesh → scale [sx, sy, sz]."""
 
-    name: str
-    shape: Literal["box", "sphere", "cylinder", "capsule", "mesh"] = "box"
+    name: str = Field(description="Unique name, used by commands and reports.")
+    shape: Literal["box", "sphere", "cylinder", "capsule", "mesh"] = Field("box", description="Decides what size means (see above).")
     size: Annotated[list[PositiveFloat], Field(min_length=1, max_length=3)] = Field(description="See class doc (m).")
     mesh: str | None = Field(None, description="Mesh or URDF path for shape: mesh (relative, or pybullet_data://).")
     mass: NonNegFloat = Field(0.1, description="kg; 0 makes the body static.")
@@ -27,7 +27,7 @@ class Body(Pose):
     def _size_for_shape(self) -> Body:
         need = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": 3}[self.shape]
         if len(self.size) != need:
-            raise ValueError(f"shape '{self.shape}' needs size with {need} value(s), got {len(self.size)}")
+            raise ValueError(f"'size' needs {need} value(s) for shape '{self.shape}', got {len(self.size)}")
         if self.shape == "mesh" and not self.mesh:
             raise ValueError("shape 'mesh' needs a 'mesh' path")
         return self
@@ -45,24 +45,24 @@ class Table(Pose):
     """A static box table; ``position`` is the centre of its top surface."""
 
     size: Vec3 = Field(default_factory=lambda: [0.8, 1.2, 0.05], description="Top extents (m).")
-    color: Color = Field(default_factory=lambda: [0.6, 0.5, 0.4, 1.0])
-    friction: PositiveFloat = 1.0
+    color: Color = Field(default_factory=lambda: [0.6, 0.5, 0.4, 1.0], description="RGBA, 0..1.")
+    friction: PositiveFloat = Field(1.0, description="Lateral friction coefficient.")
 
 
 class Pedestal(Pose):
     """A static cylinder the robot stands on; ``position`` is the centre of its top face."""
 
-    radius: PositiveFloat = 0.15
-    height: PositiveFloat = 0.5
-    color: Color = Field(default_factory=lambda: [0.3, 0.3, 0.3, 1.0])
+    radius: PositiveFloat = Field(0.15, description="m.")
+    height: PositiveFloat = Field(0.5, description="m; the top face is at position.")
+    color: Color = Field(default_factory=lambda: [0.3, 0.3, 0.3, 1.0], description="RGBA, 0..1.")
 
 
 class Scene(Frozen):
     """Everything in the world except the robots."""
 
     ground: bool = Field(True, description="Add a ground plane at z = 0.")
-    table: Table | None = None
-    pedestal: Pedestal | None = None
+    table: Table | None = Field(None, description="Optional static table.")
+    pedestal: Pedestal | None = Field(None, description="Optional static pedestal (place the robot on its top face).")
     objects: list[Body] = Field(default_factory=list, description="Movable objects.")
     obstacles: list[Body] = Field(default_factory=list, description="Static obstacles (mass is ignored).")
 

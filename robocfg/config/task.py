@@ -33,35 +33,35 @@ class RobotMount(Pose):
 
 class _TaskBase(Frozen):
     schema_version: Literal[1] = Field(description="File format version; this is 1.")
-    description: str = ""
+    description: str = Field("", description="Free text.")
     robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
-    scene: Scene = Field(default_factory=Scene)
-    sim: Sim = Field(default_factory=Sim)
+    scene: Scene = Field(default_factory=Scene, description="Everything in the world besides the robots.")
+    sim: Sim = Field(default_factory=Sim, description="Simulation settings.")
 
 
 class GripperTask(_TaskBase):
-    task: Literal["gripper"]
-    gripper: GripperParams = Field(default_factory=GripperParams)
+    task: Literal["gripper"] = Field(description="The command this file configures; selects the parameter block.")
+    gripper: GripperParams = Field(default_factory=GripperParams, description="Parameters of `robocfg run gripper`.")
 
 
 class TrajectoryTask(_TaskBase):
-    task: Literal["trajectory"]
-    trajectory: TrajectoryParams = Field(default_factory=TrajectoryParams)
+    task: Literal["trajectory"] = Field(description="The command this file configures; selects the parameter block.")
+    trajectory: TrajectoryParams = Field(default_factory=TrajectoryParams, description="Parameters of `robocfg run trajectory`.")
 
 
 class FollowTargetTask(_TaskBase):
-    task: Literal["follow_target"]
-    follow_target: FollowTargetParams = Field(default_factory=FollowTargetParams)
+    task: Literal["follow_target"] = Field(description="The command this file configures; selects the parameter block.")
+    follow_target: FollowTargetParams = Field(default_factory=FollowTargetParams, description="Parameters of `robocfg run follow-target`.")
 
 
 class PickPlaceTask(_TaskBase):
-    task: Literal["pick_place"]
-    pick_place: PickPlaceParams
+    task: Literal["pick_place"] = Field(description="The command this file configures; selects the parameter block.")
+    pick_place: PickPlaceParams = Field(description="Parameters of `robocfg run pick-place`.")
 
 
 class GraspTask(_TaskBase):
-    task: Literal["grasp"]
-    grasp: GraspParams = Field(default_factory=GraspParams)
+    task: Literal["grasp"] = Field(description="The command this file configures; selects the parameter block.")
+    grasp: GraspParams = Field(default_factory=GraspParams, description="Parameters of `robocfg run grasp`.")
 
 
 TaskConfig = Annotated[
