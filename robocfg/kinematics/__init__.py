@@ -1,0 +1,1 @@
+"""Kinematics: pinocchio model, FK, Jacobians, IK backends, grasp/TCP frames."""

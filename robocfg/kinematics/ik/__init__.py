@@ -1,0 +1,11 @@
+"""IK backends behind one interface: ``solve(target, seed_q, ...) -> IKResult``.
+
+Backends are looked up by name in :mod:`robocfg.kinematics.ik.registry` (the robot YAML's
+``ik_backend``): ``lm`` (Levenberg–Marquardt with random restarts), ``pink`` (differential-IK
+QP), ``placo`` (placo's kinematics solver).
+"""
+
+from robocfg.kinematics.ik.registry import get_backend, known_backends, register
+from robocfg.kinematics.ik.result import IKResult
+
+__all__ = ["IKResult", "get_backend", "known_backends", "register"]

@@ -1,0 +1,130 @@
+"""Helpers shared by the IK backends: target checks, residuals, limits and wrapping."""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from robocfg.errors import RobocfgError
+
+if TYPE_CHECKING:
+    from robocfg.kinematics.ik.result import IKResult
+    from robocfg.kinematics.model import KinematicModel
+
+TWO_PI = 2 * math.pi
+LIMIT_TOL = 1e-6  # rad or m: "at a limit"
+
+
+def check_target(target: np.ndarray) -> np.ndarray:
+    """A finite 4x4 homogeneous transform with a proper rotation block, as float64 (a copy).
+
+    Written with Python scalars: it runs once per IK query and numpy's per-call overhead would
+    dominate on a 4x4 matrix.
+    """
+    T = np.array(target, dtype=float)
+    if T.shape != (4, 4):
+        raise RobocfgError(f"IK target must be a 4x4 homogeneous matrix, got shape {T.shape}")
+    (a, b, c, _), (d, e, f, _), (g, h, i, _), _ = rows = T.tolist()
+    if not math.isfinite(sum(rows[0]) + sum(rows[1]) + sum(rows[2]) + sum(rows[3])):
+        raise RobocfgError("IK target contains NaN or infinite values")
+    worst = max(abs(a * a + b * b + c * c - 1.0), abs(d * d + e * e + f * f - 1.0),
+                abs(g * g + h * h + i * i - 1.0), abs(a * d + b * e + c * f),
+                abs(a * g + b * h + c * i), abs(d * g + e * h + f * i))
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    if worst > 1e-6 or abs(det - 1.0) > 1e-6:
+        raise RobocfgError("IK target rotation is not a rotation matrix (orthonormal, det +1)")
+    return T
+
+
+def check_seed(model: KinematicModel, seed_q: np.ndarray) -> np.ndarray:
+    """The seed as a float array brought into the limits (wrapped or clamped)."""
+    q = np.array(seed_q, dtype=float).reshape(-1)
+    if q.shape[0] != model.nq:
+        raise RobocfgError(f"seed_q has {q.shape[0]} values; the arm has {model.nq} joints")
+    if not all(math.isfinite(v) for v in q.tolist()):
+        raise RobocfgError("seed_q contains NaN or infinite values")
+    return into_limits(model, q)
+
+
+def into_limits(model: KinematicModel, q: np.ndarray) -> np.ndarray:
+    """``q`` within the limits: wrapped joints (≥ 2π wide) outside their range are shifted by
+    multiples of 2π (values already inside are kept), the others are clamped."""
+    q = q.copy()
+    if model.any_wrap:
+        w, lo, hi = model.wrap, model.lower, model.upper
+        q = np.where(w & (q > hi), q - TWO_PI * np.ceil((q - hi) / TWO_PI), q)
+        q = np.where(w & (q < lo), q + TWO_PI * np.ceil((lo - q) / TWO_PI), q)
+    return np.minimum(np.maximum(q, model.lower), model.upper)
+
+
+def nearest_equivalent(model: KinematicModel, q: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """``q`` with each wrapped joint moved by a multiple of 2π to the value within its limits
+    nearest to ``ref`` (the seed): the same pose, the least joint travel."""
+    if not model.any_wrap:
+        return q
+    cand = q + TWO_PI * np.round((ref - q) / TWO_PI)
+    cand = np.where(cand > model.upper, cand - TWO_PI, cand)
+    cand = np.where(cand < model.lower, cand + TWO_PI, cand)
+    ok = model.wrap & (cand >= model.lower) & (cand <= model.upper)
+    return np.where(ok, cand, q)
+
+
+def residuals(T: np.ndarray, target: np.ndarray) -> tuple[float, float]:
+    """(position error m, rotation angle rad) between two 4x4 poses."""
+    dp = float(np.linalg.norm(T[:3, 3] - target[:3, 3]))
+    w = pin.log3(target[:3, :3].T @ T[:3, :3])
+    return dp, float(np.linalg.norm(w))
+
+
+def joints_at_limit(model: KinematicModel, q: np.ndarray) -> list[str]:
+    """Names of the (non-wrapped) joints within LIMIT_TOL of a limit."""
+    return [n for n, v, lo, hi, w in zip(model.joint_names, q.tolist(), model.lower.tolist(),
+                                         model.upper.tolist(), model.wrap.tolist(), strict=True)
+            if not w and (v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL)]
+
+
+def search(km: KinematicModel, descend, q0: np.ndarray, deadline: float,
+           rng: np.random.Generator | None, clock=None) -> tuple[np.ndarray, int, int]:
+    """Run ``descend(q, deadline) -> (converged, iterations, score, q)`` from ``q0``, then from
+    uniform random configurations, until one converges or the deadline passes.
+
+    ``deadline`` is on ``clock`` (default ``time.perf_counter``).
+    Returns (best q by score, total iterations, restarts).
+    """
+    from time import perf_counter
+
+    clock = clock or perf_counter
+    best_s, best_q = math.inf, q0
+    iters = restarts = 0
+    q = q0
+    while True:
+        ok, it, s, q_end = descend(q, deadline)
+        iters += it
+        if s < best_s:
+            best_s, best_q = s, q_end
+        if ok or clock() >= deadline:
+            return best_q, iters, restarts
+        restarts += 1
+        if rng is None:
+            rng = np.random.default_rng(0)
+        q = rng.uniform(km.lower, km.upper)
+
+
+def finish(km: KinematicModel, backend: str, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool,
+           tol_pos: float, tol_rot: float, t0: float, iters: int, restarts: int) -> IKResult:
+    """The IKResult for ``q``: residuals by FK (m, rad), convergence against the tolerances."""
+    from time import perf_counter
+
+    from robocfg.kinematics.ik.result import IKResult
+
+    pin.forwardKinematics(km.model, km.data, q)
+    d = pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)
+    pe = math.sqrt(d.translation.dot(d.translation))
+    w = pin.log3(d.rotation)
+    re = 0.0 if position_only else math.sqrt(w.dot(w))
+    return IKResult(q=q, converged=bool(pe <= tol_pos and re <= tol_rot), pos_err=pe, rot_err=re,
+                    iterations=iters, time_s=perf_counter() - t0, joints_at_limit=joints_at_limit(km, q),
+                    backend=backend, restarts=restarts)

@@ -1,0 +1,286 @@
+"""Kinematic model of one arm (pinocchio): FK of any frame, frame Jacobians, and IK.
+
+Built from the same resolved URDF the simulator loads. Every joint that is not an arm joint is
+locked (gripper leaders at their configured ``open`` value, mimic followers following, other arms
+at their ``home``), the base mount is applied, and the TCP is a fixed frame ``"tcp"`` at
+``tcp_offset`` along ``ee_axis`` of ``ee_link``.
+
+Frames: every pose is ``world_T_frame`` (4x4, metres), where ``world_T_base`` is the mount pose of
+the URDF's root link (identity if not given). Joint values are in arm-joint order (rad or m).
+Continuous joints are modelled as revolute joints with limits [-π, π]; they and joints whose
+range spans 2π or more are *wrapped* (not clamped) by the IK solvers.
+
+pinocchio is imported here: import this module lazily from the CLI.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from robocfg.config.types import AXIS_INDEX
+from robocfg.errors import NotFound, RobocfgError
+
+if TYPE_CHECKING:
+    from robocfg.checks.robot import CheckedRobot
+    from robocfg.kinematics.ik.result import IKResult
+
+TCP_FRAME = "tcp"
+
+
+def _urdf_xml_without_continuous(path: str) -> tuple[str, set[str]]:
+    """The URDF text with continuous joints turned into revolute ones limited to [-π, π].
+
+    pinocchio models continuous joints with two coordinates (cos, sin); one angle per joint keeps
+    the interface simple. Returns (xml text, names of the converted joints).
+    """
+    from robocfg.assets.urdf import read_urdf_xml
+
+    root = read_urdf_xml(path)
+    converted: set[str] = set()
+    for j in root.iter("joint"):
+        if j.get("type") != "continuous":
+            continue
+        j.set("type", "revolute")
+        lim = j.find("limit")
+        if lim is None:
+            lim = ET.SubElement(j, "limit")
+            lim.set("effort", "0")
+            lim.set("velocity", "0")
+        lim.set("lower", repr(-math.pi))
+        lim.set("upper", repr(math.pi))
+        converted.add(j.get("name", ""))
+    return ET.tostring(root, encoding="unicode"), converted
+
+
+@dataclass
+class KinematicModel:
+    """A pinocchio model of one arm with everything else locked. Build it with :meth:`from_robot`."""
+
+    model: pin.Model
+    data: pin.Data
+    joint_names: list[str]
+    lower: np.ndarray  # rad or m, arm-joint order
+    upper: np.ndarray
+    velocity_limits: np.ndarray  # rad/s or m/s
+    wrap: np.ndarray  # bool: continuous or ≥ 2π-wide joints (wrapped, not clamped)
+    ee_link: str
+    home: np.ndarray
+    base_pose: np.ndarray  # world_T_base (4x4)
+    urdf_path: str = ""
+    locked: dict[str, float] = field(default_factory=dict)  # locked joint → value (rad or m)
+    default_backend: str = "lm"
+    _solvers: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        # OP_FRAME: a URDF link that happens to be called 'tcp' is a BODY frame and stays reachable by type
+        self._tcp_id = int(self.model.getFrameId(TCP_FRAME, pin.FrameType.OP_FRAME))
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_robot(
+        cls,
+        robot: CheckedRobot,
+        arm: str | None = None,
+        base_pose: np.ndarray | None = None,
+        gripper_q: dict[str, float] | None = None,
+    ) -> KinematicModel:
+        """Model of ``arm`` (default: the first) of a checked robot.
+
+        ``base_pose``: 4x4 world_T_base of the URDF root link (the task's mount pose).
+        ``gripper_q``: joint name → value for locked joints (default: gripper ``open``,
+        other arms at ``home``, anything else 0 clipped into its limits); mimic followers follow
+        their leader (``multiplier · q + offset``).
+        """
+        cfg = robot.config
+        arm_cfg = cfg.arm(arm)
+        xml, continuous = _urdf_xml_without_continuous(str(robot.urdf_path))
+        full = pin.buildModelFromXML(xml)
+        arm_joints = robot.arm_joints(arm_cfg)
+
+        locked = _locked_values(robot, arm_cfg.name, gripper_q or {})
+        q_full = pin.neutral(full)
+        lock_ids = []
+        for jid in range(1, full.njoints):
+            name = full.names[jid]
+            if name in arm_joints:
+                continue
+            lock_ids.append(jid)
+            j = full.joints[jid]
+            if j.nq != 1:
+                raise RobocfgError(f"joint {name!r} has {j.nq} coordinates; only 1-DOF joints can be locked")
+            lo, hi = full.lowerPositionLimit[j.idx_q], full.upperPositionLimit[j.idx_q]
+            q_full[j.idx_q] = locked[name] if name in locked else float(np.clip(0.0, lo, hi))
+        model = pin.buildReducedModel(full, lock_ids, q_full) if lock_ids else full
+        names = [model.names[i] for i in range(1, model.njoints)]
+        if names != arm_joints:
+            raise RobocfgError(f"pinocchio joint order {names} differs from the arm joints {arm_joints}")
+        if model.nq != len(arm_joints):
+            raise RobocfgError(f"arm joints must be 1-DOF; pinocchio nq = {model.nq} for {len(arm_joints)} joints")
+
+        M_base = pin.SE3.Identity() if base_pose is None else _se3(base_pose, "base_pose")
+        for jid in range(1, model.njoints):
+            if model.parents[jid] == 0:
+                model.jointPlacements[jid] = M_base * model.jointPlacements[jid]
+        for fid in range(model.nframes):
+            fr = model.frames[fid]
+            if fr.parentJoint == 0 and fid != 0:
+                fr.placement = M_base * fr.placement
+                model.frames[fid] = fr
+
+        ee_id = _frame_id(model, arm_cfg.ee_link)
+        ee = model.frames[ee_id]
+        offset = np.zeros(3)
+        offset[AXIS_INDEX[arm_cfg.ee_axis]] = arm_cfg.tcp_offset
+        tcp = pin.Frame(TCP_FRAME, ee.parentJoint, ee_id, ee.placement * pin.SE3(np.eye(3), offset), pin.FrameType.OP_FRAME)
+        model.addFrame(tcp)
+
+        lower = np.array(model.lowerPositionLimit, dtype=float)
+        upper = np.array(model.upperPositionLimit, dtype=float)
+        wrap = np.array([(n in continuous) or (u - lo_ >= 2 * math.pi - 1e-9) for n, lo_, u in zip(arm_joints, lower, upper, strict=True)])
+        vel = np.array(model.velocityLimit, dtype=float)
+        for k, n in enumerate(arm_joints):
+            if n in cfg.drives.velocity_limits:
+                vel[k] = cfg.drives.velocity_limits[n]
+        return cls(
+            model=model,
+            data=model.createData(),
+            joint_names=list(arm_joints),
+            lower=lower,
+            upper=upper,
+            velocity_limits=vel,
+            wrap=wrap,
+            ee_link=arm_cfg.ee_link,
+            home=np.array(arm_cfg.home, dtype=float),
+            base_pose=M_base.homogeneous.copy(),
+            urdf_path=str(robot.urdf_path),
+            locked={full.names[j]: float(q_full[full.joints[j].idx_q]) for j in lock_ids},
+            default_backend=cfg.ik_backend,
+        )
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def nq(self) -> int:
+        return int(self.model.nq)
+
+    @property
+    def any_wrap(self) -> bool:
+        """True if some joint is continuous or ≥ 2π wide (wrapped instead of clamped)."""
+        return bool(self.wrap.any())
+
+    @property
+    def mid(self) -> np.ndarray:
+        """Midpoint of the joint limits."""
+        return (self.lower + self.upper) / 2
+
+    def frame_id(self, frame: str = TCP_FRAME) -> int:
+        """pinocchio frame index of ``"tcp"``, ``"ee"`` (the ee_link) or any link name."""
+        if frame == TCP_FRAME:
+            return self._tcp_id
+        return _frame_id(self.model, self.ee_link if frame == "ee" else frame)
+
+    def frame_name(self, frame: str = TCP_FRAME) -> str:
+        """The pinocchio frame name behind ``frame`` ("ee" → the ee_link)."""
+        return self.model.frames[self.frame_id(frame)].name
+
+    def fk(self, q: np.ndarray, frame: str = TCP_FRAME) -> np.ndarray:
+        """world_T_frame (4x4) at joint values ``q`` (arm order)."""
+        q = self._q(q)
+        fid = self.frame_id(frame)
+        pin.forwardKinematics(self.model, self.data, q)
+        return pin.updateFramePlacement(self.model, self.data, fid).homogeneous.copy()
+
+    def jacobian(self, q: np.ndarray, frame: str = TCP_FRAME) -> np.ndarray:
+        """(6, nq) Jacobian of ``frame``: rows (v, ω) of the frame origin, world-aligned axes."""
+        q = self._q(q)
+        fid = self.frame_id(frame)
+        return pin.computeFrameJacobian(self.model, self.data, q, fid, pin.LOCAL_WORLD_ALIGNED).copy()
+
+    def within_limits(self, q: np.ndarray, tol: float = 1e-9) -> bool:
+        q = np.asarray(q, dtype=float)
+        return bool(np.all(q >= self.lower - tol) and np.all(q <= self.upper + tol))
+
+    def ik(
+        self,
+        target: np.ndarray,
+        seed_q: np.ndarray | None = None,
+        frame: str = TCP_FRAME,
+        backend: str | None = None,
+        time_budget: float = 0.02,
+        position_only: bool = False,
+        rng: np.random.Generator | None = None,
+    ) -> IKResult:
+        """Joint values putting ``frame`` at ``target`` (4x4 world_T_frame).
+
+        ``seed_q`` defaults to the arm's home. ``time_budget`` (s) bounds the search (random
+        restarts inside it); ``backend`` defaults to the robot YAML's ``ik_backend``.
+        ``rng`` drives the restarts (default: ``default_rng(0)``, so results are reproducible).
+        Never raises for unreachable targets (``converged=False`` with the best residual);
+        raises RobocfgError for a NaN/inf or malformed target.
+        """
+        solver = self.solver(backend)
+        return solver.solve(
+            target, seed_q=self.home if seed_q is None else seed_q, frame=frame,
+            time_budget=time_budget, position_only=position_only,
+            rng=rng,
+        )
+
+    def solver(self, backend: str | None = None):
+        """The (cached) solver instance of ``backend`` (default: the robot YAML's ``ik_backend``),
+        e.g. to change its tolerances or its ``clock``."""
+        from robocfg.kinematics.ik.registry import get_backend
+
+        name = backend or self.default_backend
+        solver = self._solvers.get(name)
+        if solver is None:
+            solver = self._solvers[name] = get_backend(name)(self)
+        return solver
+
+    # ------------------------------------------------------------------ helpers
+    def _q(self, q: np.ndarray) -> np.ndarray:
+        q = np.asarray(q, dtype=float).reshape(-1)
+        if q.shape[0] != self.nq:
+            raise RobocfgError(f"expected {self.nq} joint values ({', '.join(self.joint_names)}), got {q.shape[0]}")
+        return q
+
+
+def _se3(T: np.ndarray, what: str) -> pin.SE3:
+    T = np.asarray(T, dtype=float)
+    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+        raise RobocfgError(f"{what} must be a finite 4x4 matrix")
+    R = T[:3, :3]
+    if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or abs(np.linalg.det(R) - 1) > 1e-6:
+        raise RobocfgError(f"{what}: the rotation block is not a rotation matrix")
+    return pin.SE3(R.copy(), T[:3, 3].copy())
+
+
+def _frame_id(model: pin.Model, name: str) -> int:
+    if model.existFrame(name, pin.FrameType.BODY):
+        return int(model.getFrameId(name, pin.FrameType.BODY))
+    if model.existFrame(name):
+        return int(model.getFrameId(name))
+    known = sorted({f.name for f in model.frames if f.type in (pin.FrameType.BODY, pin.FrameType.OP_FRAME)})
+    raise NotFound("frame", name, ["ee", *known])
+
+
+def _locked_values(robot: CheckedRobot, arm_name: str, overrides: dict[str, float]) -> dict[str, float]:
+    """Values of the locked joints: grippers open, other arms at home, mimic followers following."""
+    from robocfg.config.robot import ParallelGripperConfig
+
+    values: dict[str, float] = {}
+    for a in robot.config.arms:
+        if a.name != arm_name:
+            values.update(zip(robot.arm_joints(a), a.home, strict=True))
+        if isinstance(a.gripper, ParallelGripperConfig):
+            values.update(zip(robot.gripper_joints(a), a.gripper.open, strict=True))
+    values.update(overrides)
+    for j in robot.urdf.joints.values():
+        if j.mimic is not None and j.name not in overrides:
+            leader = values.get(j.mimic.joint, 0.0)
+            values[j.name] = j.mimic.multiplier * leader + j.mimic.offset
+    return values
