@@ -57,7 +57,7 @@ def main() -> None:
     for label, task in (("as shipped", base), ("±10 % mass & friction", varied)):
         report, timing = run_pick_place(task, episodes=args.episodes, seed=args.seed)
         steps = float(np.mean([e.steps for e in report.episodes]))
-        bare = bare_loop_seconds(task, int(round(steps)))
+        bare = bare_loop_seconds(task, round(steps))
         per_ep = timing.mean_episode
         rows.append({
             "variant": label, "episodes": report.summary.episodes, "success_rate": report.summary.success_rate,

@@ -6,7 +6,13 @@ import pytest
 from robocfg.checks import load_robot
 from robocfg.config import catalog
 from robocfg.config.types import AXIS_INDEX
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation, tcp_from_ee, top_down_grasps
+from robocfg.kinematics.frames import (
+    Grasp,
+    ee_pose_from_grasp,
+    grasp_rotation,
+    tcp_from_ee,
+    top_down_grasps,
+)
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,390 @@
+"""Reactive Cartesian controller: one placo QP per control step.
+
+Each step solves for a joint step ``Δq`` (rad) that moves ``ee_link`` towards a servo pose (the
+target's feed-forward velocity plus ``gain`` × the error, speed-capped; a soft frame task),
+keeps the arm near its posture (a tiny-weight joints task) with damped least squares (a
+regularisation task), respects joint position/velocity/acceleration limits (a hard joint-space box
+with braking distance, see :mod:`.limits`), and keeps every robot–environment (and non-adjacent
+self) collision pair at least ``margin`` apart with a velocity damper
+``n·(J_B − J_A)·Δq ≥ −approach_gain·dt·(d − margin) (− n·v_obstacle·dt)`` — placo half-space rows
+filled from coal distances between convex hulls (:mod:`.distances`) inside ``trigger``.
+
+Warm start: the QP is linearised at the previous command (not the noisy measurement), so commands
+are continuous; the measured state re-seeds it only after a deviation above ``resync_tolerance``.
+Failure handling: an infeasible hard-collision QP is re-solved with soft collision constraints,
+and if that fails too the step commands zero velocity. Frames: world, 4×4 transforms, metres.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robocfg.motion.reactive.collision import (
+    EnvShape,
+    LinkGeometry,
+    add_environment,
+    add_robot_geometry,
+    point_clearance,
+    robot_geometry_ids,
+    set_environment_pose,
+    to_convex_hulls,
+)
+from robocfg.motion.reactive.distances import DistanceField
+from robocfg.motion.reactive.escape import Blocking, EscapeRule, EscapeSettings
+from robocfg.motion.reactive.limits import step_bounds
+
+
+@dataclass(frozen=True)
+class ArmSpec:
+    """What the controller needs to know about one arm (arrays in arm-joint order)."""
+
+    urdf_path: Path
+    joint_names: list[str]
+    ee_link: str
+    T_ee_tcp: np.ndarray  # 4×4, TCP in the ee_link frame
+    base_pose: np.ndarray  # 4×4, world pose of the URDF root link
+    lower: np.ndarray  # rad
+    upper: np.ndarray  # rad
+    velocity_limits: np.ndarray  # rad/s
+    acceleration_limits: np.ndarray  # rad/s²
+    posture: np.ndarray  # rad, the regularisation target (e.g. home)
+    other_joints: dict[str, float] = field(default_factory=dict)  # non-arm DOFs held at these values
+    collision: list[LinkGeometry] | None = None  # robot collision geometry; None: placo loads the URDF's
+
+
+@dataclass(frozen=True)
+class ReactiveSettings:
+    dt: float  # control period (s)
+    margin: float = 0.02  # m, safety distance kept from the environment
+    trigger: float = 0.12  # m, pairs closer than this enter the QP
+    self_trigger: float = 0.05  # m, same for robot self pairs
+    approach_gain: float = 10.0  # 1/s: a pair may close at most approach_gain·(d − margin) m/s
+    position_weight: float = 1.0
+    orientation_weight: float = 1.0
+    posture_weight: float = 1e-6
+    damping: float = 3e-3  # weight of ‖Δq‖² (damped least squares: no drift or swaying at singularities)
+    self_collision: bool = True
+    resync_tolerance: float = 0.05  # rad: measured-vs-commanded gap that re-seeds the QP
+    gain: float = 20.0  # 1/s: Cartesian servo gain (the QP is asked to close gain·dt of the error)
+    max_linear_speed: float = 1.0  # m/s: cap on the commanded TCP speed
+    max_angular_speed: float = 2.0  # rad/s
+    escape: EscapeSettings = field(default_factory=EscapeSettings)
+
+
+@dataclass
+class StepResult:
+    q: np.ndarray  # commanded joint positions (rad)
+    dq: np.ndarray  # commanded joint velocities (rad/s)
+    status: str  # "ok" | "soft" (collision constraints relaxed) | "fallback" (zero velocity)
+    solve_time: float  # s, wall clock of the whole step
+    cpu_time: float  # s, CPU time of the whole step (this thread; insensitive to other processes)
+    clearance: float  # m, smallest robot–obstacle distance in the model (inf if none)
+    escaping: bool  # a via point is being tracked
+    blocked: bool  # off target (> 5 mm) with a robot–environment pair within 5 mm of the margin
+
+
+def _urdf_without_geometry(path: Path) -> str:
+    """The URDF text without ``<visual>``/``<collision>`` elements (placo then loads no meshes)."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(path).getroot()
+    for link in root.iter("link"):
+        for tag in ("visual", "collision"):
+            for el in link.findall(tag):
+                link.remove(el)
+    return ET.tostring(root, encoding="unicode")
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Silence C++ prints (placo warns on stdout while loading)."""
+    import os
+    import sys
+
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
+
+class ReactiveController:
+    """Call :meth:`reset` with the start state, then :meth:`step` every ``settings.dt`` seconds."""
+
+    def __init__(self, arm: ArmSpec, env: list[EnvShape], settings: ReactiveSettings):
+        import placo
+
+        self.arm, self.s = arm, settings
+        if arm.collision is not None:  # kinematics only from the URDF (no mesh loading), our hulls
+            self.robot = placo.RobotWrapper(str(arm.urdf_path), placo.Flags.ignore_collisions,
+                                            _urdf_without_geometry(arm.urdf_path))
+            add_robot_geometry(self.robot.collision_model, self.robot.model, arm.collision)
+        else:
+            with _quiet_stdout():
+                self.robot = placo.RobotWrapper(str(arm.urdf_path), placo.Flags.ignore_collisions)
+        r = self.robot
+        r.set_T_world_fbase(np.asarray(arm.base_pose, float))
+        for name, value in arm.other_joints.items():
+            r.set_joint(name, float(value))
+        self.geom = r.collision_model
+        self.hulls = to_convex_hulls(self.geom)
+        self.n = len(arm.joint_names)
+        self.env = {e.name: e for e in env}
+        self.env_ids = add_environment(self.geom, env)
+        self._q_index = np.array([r.get_joint_offset(j) for j in arm.joint_names])
+        self._v_index = np.array([r.get_joint_v_offset(j) for j in arm.joint_names])
+        self._set_q(arm.posture)
+        self._select_pairs()
+
+        s = self.solver = placo.KinematicsSolver(r)
+        s.mask_fbase(True)
+        for name in r.joint_names():
+            if name not in arm.joint_names:
+                s.mask_dof(name)
+        s.dt = settings.dt
+        s.enable_joint_limits(False)  # handled by the box below (with braking distance)
+        s.enable_velocity_limits(False)
+        self.task = s.add_frame_task(arm.ee_link, np.eye(4))
+        self.task.configure("target", "soft", settings.position_weight, settings.orientation_weight)
+        self.posture = s.add_joints_task()
+        self.posture.set_joints({j: float(v) for j, v in zip(arm.joint_names, arm.posture, strict=True)})
+        self.posture.configure("posture", "soft", settings.posture_weight)
+        self.regularization = s.add_regularization_task(settings.damping)
+        nq = r.model.nq
+        A = np.zeros((2 * self.n, nq))
+        A[np.arange(self.n), self._q_index] = 1.0
+        A[self.n + np.arange(self.n), self._q_index] = -1.0
+        self.box = s.add_joint_space_half_spaces_constraint(A, np.zeros(2 * self.n))
+        self.box.configure("limits", "hard", 1.0)
+        rows = max(len(self.pairs), 1)
+        self.collisions = s.add_joint_space_half_spaces_constraint(np.zeros((rows, nq)), np.ones(rows))
+        self.collisions.configure("collisions", "hard", 1.0)
+        self.escape = EscapeRule(settings.escape, settings.margin)
+        env_geoms = list(self.env_ids.values())
+        self.escape.clearance_fn = lambda p: point_clearance(self.geom, env_geoms, p)
+        self._T_tcp_ee = np.linalg.inv(np.asarray(arm.T_ee_tcp, float))
+        self.q = np.asarray(arm.posture, float).copy()
+        self.dq = np.zeros(self.n)
+        self.t = 0.0
+        self.fallbacks = 0
+        self.soft_steps = 0
+        self._jacobians: dict[int, np.ndarray] = {}
+        self._env_velocity: dict[int, np.ndarray] = {}
+
+    # -- model ---------------------------------------------------------------------------------
+    def _set_q(self, q: np.ndarray) -> None:
+        for name, v in zip(self.arm.joint_names, q, strict=True):
+            self.robot.set_joint(name, float(v))
+        self.robot.update_kinematics()
+
+    def _select_pairs(self) -> None:
+        """Robot–environment pairs for every moving robot geometry (except pairs with a non-obstacle
+        shape such as the pedestal or table that are already within the margin at the posture: the
+        robot stands on it); self pairs for geometries more than ``2·margin`` apart at the posture
+        (adjacent hulls overlap and are skipped)."""
+        import pinocchio as pin
+
+        g = self.geom
+        g.removeAllCollisionPairs()
+        base_joints = {0, 1}  # universe and placo's floating base: geometry there cannot move
+        robot_ids = robot_geometry_ids(g, base_joints)
+        all_robot = robot_geometry_ids(g, set())
+        for rid in robot_ids:
+            for eid in self.env_ids.values():
+                g.addCollisionPair(pin.CollisionPair(rid, eid))
+        if self.s.self_collision:
+            anc = self._arm_ancestors()
+            for a in all_robot:
+                for b in all_robot:
+                    ja, jb = anc[g.geometryObjects[a].parentJoint], anc[g.geometryObjects[b].parentJoint]
+                    if a < b and ja != jb:  # same arm-joint ancestor: rigid to each other in the QP
+                        g.addCollisionPair(pin.CollisionPair(a, b))
+        self._set_q(self.arm.posture)
+        field = DistanceField(self.robot.model, g)
+        field.update(np.asarray(self.robot.state.q))
+        found, _ = field.query(np.inf)
+        keep, self.support_pairs = [], []
+        for d in found:
+            na, nb = g.geometryObjects[d.a].name, g.geometryObjects[d.b].name
+            if nb.startswith("env:"):
+                if not self.env[nb[4:]].obstacle and d.distance < self.s.margin:
+                    self.support_pairs.append((na, nb[4:]))  # robot resting on/next to it: not avoided
+                    continue
+            elif d.distance <= 2 * self.s.margin:
+                continue  # self pair already close at the posture (adjacent hulls overlap)
+            keep.append((d.a, d.b))
+        g.removeAllCollisionPairs()
+        for a, b in keep:
+            g.addCollisionPair(pin.CollisionPair(a, b))
+        self.pairs = [(p.first, p.second) for p in g.collisionPairs]
+        self._names = [o.name for o in g.geometryObjects]
+        self._env_pair = np.array([self._names[b].startswith("env:") for _, b in self.pairs], dtype=bool)
+        self._obstacle_pair = np.array([self._env_pair[k] and self.env[self._names[b][4:]].obstacle
+                                        for k, (_, b) in enumerate(self.pairs)], dtype=bool)
+        self.field = DistanceField(self.robot.model, g)
+        self._cutoff = np.where(self._env_pair, self.s.trigger, self.s.self_trigger)
+
+    def _arm_ancestors(self) -> list[int]:
+        """For every pinocchio joint, the nearest arm joint at or above it (0 for none): geometry
+        below the same arm joint moves rigidly in the QP (gripper joints are held fixed)."""
+        model = self.robot.model
+        arm_ids = {model.getJointId(n) for n in self.arm.joint_names}
+        out = []
+        for j in range(model.njoints):
+            k = j
+            while k > 0 and k not in arm_ids:
+                k = model.parents[k]
+            out.append(k)
+        return out
+
+    def set_obstacle_pose(self, name: str, pose: np.ndarray, velocity: np.ndarray | None = None) -> None:
+        """Move environment shape ``name`` to ``pose`` (4×4, world); ``velocity`` (m/s, world) is its
+        linear velocity, used so the robot keeps the margin from an approaching obstacle."""
+        self.env[name].pose = np.asarray(pose, float)
+        set_environment_pose(self.geom, self.env_ids[name], pose)
+        self._env_velocity[self.env_ids[name]] = np.zeros(3) if velocity is None else np.asarray(velocity, float)[:3]
+
+    def tcp_pose(self, q: np.ndarray | None = None) -> np.ndarray:
+        """World TCP pose (4×4) at ``q`` (default: the last command)."""
+        if q is not None:
+            self._set_q(q)
+        return np.asarray(self.robot.get_T_world_frame(self.arm.ee_link)) @ self.arm.T_ee_tcp
+
+    def distances(self) -> list[tuple[str, str, float]]:
+        """(robot geometry, environment/robot geometry, distance m) for every pair, at the model state."""
+        self.field.update(np.asarray(self.robot.state.q))
+        found, _ = self.field.query(np.inf)
+        return [(self._names[d.a], self._names[d.b], d.distance) for d in found]
+
+    def _collision_rows(self) -> tuple[list[Blocking], float]:
+        """Fill the collision half-spaces from the current distances; return the robot–environment
+        pairs inside the trigger distance and the smallest robot–obstacle distance (m)."""
+        A, b = self.collisions.A, self.collisions.b
+        A[:] = 0.0
+        b[:] = 1.0
+        q_full = np.asarray(self.robot.state.q)
+        self.field.update(q_full)
+        found, dist = self.field.query(self._cutoff)
+        clearance = float(dist[self._obstacle_pair].min()) if self._obstacle_pair.any() else float("inf")
+        near: list[Blocking] = []
+        xi = self.s.approach_gain * self.s.dt
+        self._jacobians = {}
+
+        row = 0
+        for d in found:
+            env = self._env_pair[d.pair]
+            if env:
+                near.append(Blocking(d.distance, -d.normal))
+            if d.distance >= (self.s.trigger if env else self.s.self_trigger) or row >= A.shape[0]:
+                continue
+            # d' = n·(v_B − v_A) ≥ −ξ·(d − margin): a velocity damper, n from A (robot) towards B
+            ja, jb = self.geom.geometryObjects[d.a].parentJoint, self.geom.geometryObjects[d.b].parentJoint
+            row_v = -self._normal_row(ja, d.point_a, d.normal, q_full)
+            if jb > 1:
+                row_v = row_v + self._normal_row(jb, d.point_b, d.normal, q_full)
+            A[row, self._q_index] = -row_v
+            b[row] = xi * (d.distance - self.s.margin) + A[row, self._q_index] @ self.q
+            v_b = self._env_velocity.get(d.b)
+            if v_b is not None:  # a moving obstacle: its own approach speed counts against the margin
+                b[row] += float(d.normal @ v_b) * self.s.dt
+            row += 1
+        return near, clearance
+
+    def _normal_row(self, joint: int, p: np.ndarray, n: np.ndarray, q_full: np.ndarray) -> np.ndarray:
+        """``n · J_p`` over the arm joints: the speed along ``n`` of the world point ``p`` fixed to
+        pinocchio joint ``joint``'s body, per unit arm-joint velocity (Jacobians cached per step)."""
+        import pinocchio as pin
+
+        J = self._jacobians.get(joint)
+        if J is None:
+            model, data = self.field.model, self.field.data
+            if not self._jacobians:
+                pin.computeJointJacobians(model, data, q_full)
+            J = self._jacobians[joint] = pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.WORLD)[:, self._v_index]
+        # v_p = v_O + ω × p, so n·v_p = n·v_O + (p × n)·ω
+        pxn = np.array([p[1] * n[2] - p[2] * n[1], p[2] * n[0] - p[0] * n[2], p[0] * n[1] - p[1] * n[0]])
+        return n @ J[:3] + pxn @ J[3:]
+
+    # -- control -------------------------------------------------------------------------------
+    def reset(self, q: np.ndarray, dq: np.ndarray | None = None, t: float = 0.0) -> None:
+        self.q = np.asarray(q, float).copy()
+        self.dq = np.zeros(self.n) if dq is None else np.asarray(dq, float).copy()
+        self.t = t
+        self.escape.reset()
+        self._set_q(self.q)
+
+    def _servo(self, T_tcp: np.ndarray, target: np.ndarray, velocity: np.ndarray | None) -> np.ndarray:
+        """The pose to reach this step: feed-forward velocity + ``gain`` × error, speed-capped."""
+        import pinocchio as pin
+
+        dt, k = self.s.dt, min(self.s.gain * self.s.dt, 1.0)
+        v = np.zeros(6) if velocity is None else np.asarray(velocity, float)
+        dp = v[:3] * dt + k * (target[:3, 3] - T_tcp[:3, 3])
+        n = float(np.linalg.norm(dp))
+        if n > self.s.max_linear_speed * dt:
+            dp *= self.s.max_linear_speed * dt / n
+        dw = v[3:] * dt + k * (T_tcp[:3, :3] @ pin.log3(T_tcp[:3, :3].T @ target[:3, :3]))
+        n = float(np.linalg.norm(dw))
+        if n > self.s.max_angular_speed * dt:
+            dw *= self.s.max_angular_speed * dt / n
+        out = np.eye(4)
+        out[:3, 3] = T_tcp[:3, 3] + dp
+        out[:3, :3] = pin.exp3(dw) @ T_tcp[:3, :3]
+        return out
+
+    def step(self, T_target_tcp: np.ndarray, q_measured: np.ndarray | None = None,
+             velocity: np.ndarray | None = None) -> StepResult:
+        """One control step towards the world TCP pose ``T_target_tcp`` (4×4); ``velocity`` is the
+        target's (vx, vy, vz, wx, wy, wz) in m/s and rad/s, world frame, used as feed-forward."""
+        t0, c0 = time.perf_counter(), time.thread_time()
+        if q_measured is not None and np.max(np.abs(np.asarray(q_measured) - self.q)) > self.s.resync_tolerance:
+            self.q = np.asarray(q_measured, float).copy()
+            self.dq[:] = 0.0
+        self._set_q(self.q)
+        self.t += self.s.dt
+        blocking, clearance = self._collision_rows()
+        T_tcp = np.asarray(self.robot.get_T_world_frame(self.arm.ee_link)) @ self.arm.T_ee_tcp
+        target = np.asarray(T_target_tcp, float).copy()
+        target[:3, 3] = self.escape.update(self.t, T_tcp[:3, 3], target[:3, 3], blocking)
+        if self.escape.active:
+            velocity = None
+        self.task.T_world_frame = self._servo(T_tcp, target, velocity) @ self._T_tcp_ee
+        lo, hi = step_bounds(self.q, self.dq, self.arm.lower, self.arm.upper,
+                             self.arm.velocity_limits, self.arm.acceleration_limits, self.s.dt)
+        b = self.box.b
+        b[: self.n] = self.q + hi
+        b[self.n :] = -(self.q + lo)
+        status = "ok"
+        try:
+            self.solver.solve(True)
+        except RuntimeError:
+            status = "soft"
+            self._set_q(self.q)
+            self.collisions.configure("collisions", "soft", 1e3)
+            try:
+                self.solver.solve(True)
+            except RuntimeError:
+                status = "fallback"
+            self.collisions.configure("collisions", "hard", 1.0)
+        if status == "fallback":
+            q_new = self.q.copy()  # hold: zero velocity
+            self.fallbacks += 1
+        else:
+            q_new = np.asarray(self.robot.state.q)[self._q_index].copy()
+            self.soft_steps += status == "soft"
+        self.dq = (q_new - self.q) / self.s.dt
+        self.q = q_new
+        off_target = float(np.linalg.norm(T_tcp[:3, 3] - np.asarray(T_target_tcp)[:3, 3])) > 0.005
+        blocked = off_target and any(b.distance < self.s.margin + 0.005 for b in blocking)
+        return StepResult(self.q.copy(), self.dq.copy(), status, time.perf_counter() - t0, time.thread_time() - c0,
+                          clearance, self.escape.active, blocked)

@@ -1,0 +1,118 @@
+"""Build the controller's inputs from config: the arm (limits, TCP, mount) and the environment shapes.
+
+Frames: world, 4×4 transforms, metres. Pure numpy + config (no PyBullet).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from robocfg.config.commands import FollowObstacle
+from robocfg.config.scene import Body, Scene
+from robocfg.config.types import AXIS_INDEX, Pose
+from robocfg.errors import RobocfgError
+from robocfg.motion.reactive.collision import EnvShape, LinkGeometry
+from robocfg.motion.reactive.controller import ArmSpec
+
+DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
+
+
+def pose_matrix(pose: Pose) -> np.ndarray:
+    """4×4 world transform of a config ``Pose``."""
+    x, y, z, w = pose.quaternion_xyzw()
+    T = np.eye(4)
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, 3] = pose.position
+    return T
+
+
+def arm_spec(robot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = None,
+             acceleration: float = 10.0, velocity_scale: float = 1.0,
+             other_joints: dict[str, float] | None = None) -> ArmSpec:
+    """``ArmSpec`` for ``arm`` of a ``CheckedRobot``: URDF limits (``drives`` overrides), TCP from
+    ``tcp_offset``/``ee_axis``, posture = home; non-arm joints held at ``other_joints`` (default:
+    gripper open, mimic followers following, anything else 0)."""
+    cfg = robot.config
+    arm_cfg = cfg.arm(arm)
+    names = robot.arm_joints(arm_cfg)
+    urdf = robot.urdf
+    for n in names:
+        if urdf.joints[n].type == "continuous":
+            raise RobocfgError(f"follow-target does not support continuous joint {n!r} yet (give it limits in the URDF)")
+    vel = np.array([cfg.drives.velocity_limits.get(n) or urdf.joints[n].velocity or DEFAULT_VELOCITY for n in names])
+    acc = np.array([cfg.drives.acceleration_limits.get(n, acceleration) for n in names])
+    T_ee_tcp = np.eye(4)
+    T_ee_tcp[AXIS_INDEX[arm_cfg.ee_axis], 3] = arm_cfg.tcp_offset
+    held = dict(other_joints or {})
+    if other_joints is None and arm_cfg.gripper is not None and hasattr(arm_cfg.gripper, "open"):
+        leaders = robot.gripper_joints(arm_cfg)
+        held.update(zip(leaders, arm_cfg.gripper.open, strict=True))
+        for j in urdf.joints.values():
+            if j.mimic is not None and j.mimic.joint in held:
+                held[j.name] = j.mimic.multiplier * held[j.mimic.joint] + j.mimic.offset
+    collision, _ = robot_geometry(robot)
+    return ArmSpec(
+        urdf_path=Path(urdf_path), joint_names=names, ee_link=arm_cfg.ee_link, T_ee_tcp=T_ee_tcp,
+        base_pose=np.asarray(base_pose, float),
+        lower=np.array([urdf.joints[n].lower for n in names]), upper=np.array([urdf.joints[n].upper for n in names]),
+        velocity_limits=vel * velocity_scale, acceleration_limits=acc,
+        posture=np.asarray(arm_cfg.home, float), other_joints=held, collision=collision,
+    )
+
+
+def robot_geometry(robot) -> tuple[list[LinkGeometry], list[str]]:
+    """Every link's URDF collision geometry (meshes as scaled vertex clouds for convex hulls), and
+    the mesh files that could not be read (their links are then not avoided)."""
+    from robocfg.assets.meshes import read_vertices
+    from robocfg.assets.paths import Resolver, UnresolvedPath
+
+    resolver = Resolver(robot.path.parent, robot.config.package_dirs)
+    out: list[LinkGeometry] = []
+    missing: list[str] = []
+    for link in robot.urdf.links.values():
+        for g in link.collisions:
+            if g.kind == "mesh":
+                try:
+                    verts = read_vertices(resolver.mesh(g.filename or "", robot.urdf_path)) * np.asarray(g.scale)
+                except (UnresolvedPath, OSError, ValueError):
+                    missing.append(g.filename or link.name)
+                    continue
+                out.append(LinkGeometry(link.name, "mesh", g.origin, (), verts))
+            else:
+                out.append(LinkGeometry(link.name, g.kind, g.origin, tuple(g.size)))
+    return out, missing
+
+
+def body_shape(body: Body | FollowObstacle, obstacle: bool = True) -> EnvShape | None:
+    """EnvShape of a primitive scene body (None for meshes: they are not modelled)."""
+    if body.shape == "mesh":
+        return None
+    return EnvShape(body.name, body.shape, tuple(body.size), pose_matrix(body), obstacle)
+
+
+def scene_shapes(scene: Scene) -> tuple[list[EnvShape], list[str]]:
+    """(environment shapes, names of bodies left out) for the ground, table, pedestal and obstacles.
+    Movable ``objects`` are not avoided (the robot may touch them)."""
+    shapes: list[EnvShape] = []
+    skipped: list[str] = []
+    if scene.ground:
+        shapes.append(EnvShape("ground", "halfspace", (), np.eye(4), obstacle=False))
+    if scene.table is not None:
+        T = pose_matrix(scene.table)
+        T[:3, 3] -= T[:3, 2] * scene.table.size[2] / 2  # position is the top surface's centre
+        shapes.append(EnvShape("table", "box", tuple(scene.table.size), T, obstacle=False))
+    if scene.pedestal is not None:
+        T = pose_matrix(scene.pedestal)
+        T[:3, 3] -= T[:3, 2] * scene.pedestal.height / 2
+        shapes.append(EnvShape("pedestal", "cylinder", (scene.pedestal.radius, scene.pedestal.height), T, obstacle=False))
+    for ob in scene.obstacles:
+        s = body_shape(ob)
+        if s is None:
+            skipped.append(ob.name)
+        else:
+            shapes.append(s)
+    return shapes, skipped
