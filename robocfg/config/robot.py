@@ -26,7 +26,7 @@ from robocfg.config.types import (
 class ParallelGripperConfig(Frozen):
     """A parallel-jaw gripper held by friction. Mimic followers come from the URDF's ``<mimic>`` tags."""
 
-    type: Literal["parallel"] = "parallel"
+    type: Literal["parallel"] = Field("parallel", description="Gripper kind (selects this block).")
     joints: list[str] | None = Field(None, description="Driven (leader) joint names.")
     gripper_indices: list[int] | None = Field(None, description="DOF indices of the driven joints.")
     open: list[FiniteFloat] = Field(description="Driven-joint positions when open (rad or m).")
@@ -64,7 +64,7 @@ class ParallelGripperConfig(Frozen):
 class SuctionGripperConfig(Frozen):
     """A suction cup: attaches an object by a constraint when the cup touches it."""
 
-    type: Literal["suction"] = "suction"
+    type: Literal["suction"] = Field("suction", description="Gripper kind (selects this block).")
     link: str = Field(description="The suction-cup link (its frame is at the cup face).")
     hold_force: PositiveFloat = Field(50.0, description="Largest pulling load (N) before the object lets go.")
     activation_distance: NonNegFloat = Field(0.005, description="Max gap (m) between cup and object to attach.")
@@ -102,8 +102,8 @@ class ArmConfig(Frozen):
     home: list[FiniteFloat] = Field(description="Home joint positions (rad or m), arm-joint order.")
     home_std: list[NonNegFloat] | None = Field(None, description="Std-dev (rad) for home randomisation.")
     gripper: GripperConfig | None = Field(None, description="This arm's gripper.")
-    gripper_keypoints: GripperKeypoints | None = None
-    collision_filter: CollisionFilter = Field(default_factory=CollisionFilter)
+    gripper_keypoints: GripperKeypoints | None = Field(None, description="Gripper points in the ee_link frame (m), for drawing.")
+    collision_filter: CollisionFilter = Field(default_factory=CollisionFilter, description="Link lists for contact handling.")
 
     @model_validator(mode="after")
     def _shape(self) -> ArmConfig:
@@ -135,7 +135,7 @@ class DriveGains(Frozen):
 class Drives(Frozen):
     """Drive settings and optional limit overrides."""
 
-    arm: DriveGains = Field(default_factory=DriveGains)
+    arm: DriveGains = Field(default_factory=DriveGains, description="Position-drive gains of the arm joints.")
     velocity_limits: dict[str, PositiveFloat] = Field(default_factory=dict, description="rad/s by joint name; overrides the URDF.")
     acceleration_limits: dict[str, PositiveFloat] = Field(default_factory=dict, description="rad/s² by joint name.")
 
@@ -150,18 +150,47 @@ class Physics(Frozen):
     )
 
 
+class Attachment(Frozen):
+    """A URDF welded onto a link of the robot (e.g. a gripper on the arm's flange).
+
+    robocfg composes the robot's ``urdf`` and its attachments, in order, into one URDF (cached in
+    ``$XDG_CACHE_HOME/robocfg``); every link/joint name elsewhere in the robot YAML refers to that
+    composed URDF. An attachment's root link becomes the child of a fixed joint
+    ``{name}_mount`` on ``mount_link`` (a link of the arm or of an earlier attachment).
+    """
+
+    urdf: str = Field(description="Path relative to this YAML, or pybullet_data://, airo_models://, package://.")
+    mount_link: str = Field(description="Link (of the composed URDF so far) the attachment's root link is welded to.")
+    mount_xyz: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0], description="Root-link origin in the mount_link frame (m).")
+    mount_rpy_deg: Vec3 = Field(
+        default_factory=lambda: [0.0, 0.0, 0.0],
+        description="Root-link orientation in the mount_link frame: roll, pitch, yaw (deg), R = Rz·Ry·Rx (URDF rpy).",
+    )
+    name: str | None = Field(
+        None, pattern=r"^[A-Za-z0-9_\-]+$",
+        description="Attachment name (default: the URDF file stem); prefixes clashing names and names the mount joint.",
+    )
+    prefix: str | None = Field(
+        None, pattern=r"^[A-Za-z0-9_\-]*$",
+        description="If given, prepended to *every* link/joint name of the attachment; if not, only names that clash get '{name}_'.",
+    )
+
+
 class RobotConfig(Frozen):
     """A robot YAML file."""
 
     schema_version: Literal[1] = Field(description="File format version; this is 1.")
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", description="Robot name used on the command line.")
-    description: str = ""
+    description: str = Field("", description="Free text, shown by `robocfg robots`.")
     urdf: str = Field(description="Path relative to this YAML, or pybullet_data://, airo_models://, package://.")
     package_dirs: dict[str, str] = Field(default_factory=dict, description="package:// name → directory.")
-    fixed_base: bool = True
+    attachments: list[Attachment] = Field(
+        default_factory=list, description="URDFs welded onto the robot (grippers, tools), composed into one URDF in order."
+    )
+    fixed_base: bool = Field(True, description="Weld the URDF root link to the world (PyBullet useFixedBase).")
     arms: list[ArmConfig] = Field(min_length=1, description="One entry per arm.")
-    drives: Drives = Field(default_factory=Drives)
-    physics: Physics = Field(default_factory=Physics)
+    drives: Drives = Field(default_factory=Drives, description="Drive gains and joint-limit overrides.")
+    physics: Physics = Field(default_factory=Physics, description="Solver settings and link-mass overrides.")
     ik_backend: str = Field("lm", description="Default IK backend name.")
 
     @model_validator(mode="after")

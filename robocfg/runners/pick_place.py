@@ -30,6 +30,8 @@ from robocfg.runners.pick_place_report import (
 
 Log = Callable[[str], None]
 CARTESIAN_STEP = 0.03  # m between IK waypoints on straight TCP lines
+IK_ITERATIONS = 400  # LM iterations per IK query, over all restarts: the budget that binds (deterministic)
+IK_TIME_CAP = 1.0  # s of wall clock per IK query: only a safety net, never reached on a sane machine
 SETTLE_POLL = 4  # physics steps between convergence checks
 RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
 MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
@@ -101,8 +103,12 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
         world.step(1)
         state = world.snapshot()
         handle = world.robot.arm(arm_cfg.name)
+        model = KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=world.robot.base_pose())
+        solver = model.solver()
+        if hasattr(solver, "max_total_iter"):  # an iteration budget keeps answers independent of machine load
+            solver.max_total_iter = IK_ITERATIONS
         tools = _Tools(
-            KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=world.robot.base_pose()),
+            model,
             limits_from_robot(robot, handle.joints, Limits(velocity_scale=params.speed_scale,
                                                            acceleration_scale=params.speed_scale)),
         )
@@ -225,27 +231,33 @@ class _StateMachine:
 
     # ---- motion ------------------------------------------------------------------------------
     def _choose_grasp(self, center: np.ndarray) -> Grasp:
-        """Of the two top-down grasps, the one whose pre-grasp IK answer needs the least joint
-        travel (largest |Δq|, rad) from the current joints; the smaller wrist turn breaks ties. (IK
-        from the current joints can land on a far branch, e.g. a Panda's shoulder flipped by
-        ≈ 3 rad, for one of the two grasps only.)"""
+        """Of the two top-down grasps, the one needing the least joint travel (largest |Δq|, rad)
+        to reach the pre-grasp pose and from there the pose above the place point; the smaller
+        wrist turn breaks ties. (IK can land on a far branch for one of the two, e.g. a Panda's
+        shoulder flipped by ≈ 3 rad, or a wrist that must wind round a joint limit to carry.)"""
         b = self.setup.body
         extent = (b.size[0], b.size[1]) if b.shape in ("box", "mesh") else (2 * b.size[0], 2 * b.size[0])
         R_now = self.arm.ee_pose()[:3, :3]
         cands = sorted(top_down_grasps(center, self.setup.yaw, extent),
                        key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
         q0 = self.arm.joint_positions()
+        shift = np.array([*(self.setup.place_xy - center[:2]), 0.0])
 
         def travel(g: Grasp) -> float:
             T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
-            res = self.model.ik(T_pre, seed_q=q0, frame="ee", time_budget=0.05)
-            return float(np.max(np.abs(res.q - q0))) if res.converged else math.inf
+            cost, q = 0.0, q0
+            for T in (T_pre, _shifted(T_pre, shift)):
+                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=IK_TIME_CAP)
+                if not res.converged:
+                    return math.inf
+                cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
+            return cost
 
         costs = [travel(g) for g in cands]
         return cands[int(np.argmin(costs))] if min(costs) < math.inf else cands[0]
 
     def _solve(self, T: np.ndarray, seed: np.ndarray, what: str) -> np.ndarray:
-        res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=0.05)
+        res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=IK_TIME_CAP)
         if not res.converged:
             raise PhaseFailed(self.phase, f"unreachable{what} (residual {res.pos_err * 1000:.1f} mm, {math.degrees(res.rot_err):.1f}°)")
         return res.q

@@ -1,0 +1,82 @@
+"""`robocfg new-robot`: drafts from URDFs validate and match the hand-written robot YAMLs."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pybullet_data
+import pytest
+import yaml
+
+from robocfg.assets.draft import draft_robot, render_yaml
+from robocfg.assets.urdf import parse_urdf
+from robocfg.checks import load_robot
+from robocfg.cli.app import main
+
+ROOT = Path(__file__).resolve().parent.parent
+PANDA_URDF = Path(pybullet_data.getDataPath()) / "franka_panda" / "panda.urdf"
+IIWA_URDF = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
+KR210_URDF = ROOT / "robocfg" / "data" / "robots" / "kuka_kr210" / "kuka_kr210.urdf"
+
+
+def run_main(args: list[str], capsys, monkeypatch, cwd: Path) -> tuple[int, str, str]:
+    monkeypatch.chdir(cwd)
+    monkeypatch.delenv("ROBOCFG_DEBUG", raising=False)
+    monkeypatch.setattr(sys, "argv", ["robocfg", *args])
+    with pytest.raises(SystemExit) as exc:
+        main()
+    out, err = capsys.readouterr()
+    code = exc.value.code
+    return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
+
+
+def test_panda_draft_matches_the_shipped_yaml(tmp_path, capsys, monkeypatch):
+    code, out, _ = run_main(["new-robot", str(PANDA_URDF)], capsys, monkeypatch, tmp_path)
+    assert code == 0, out
+    assert "validate: ok" in out and "still to check" in out
+    draft_path = tmp_path / "robots" / "panda.yaml"
+    draft = load_robot(draft_path)  # the draft validates without errors
+    assert draft.warnings == []
+    got, want = draft.config.arms[0], load_robot(ROOT / "robots" / "panda.yaml").config.arms[0]
+    assert got.joints == want.joints
+    assert (got.base_link, got.ee_link, got.ee_axis) == (want.base_link, want.ee_link, want.ee_axis)
+    assert got.tcp_offset == pytest.approx(want.tcp_offset, abs=0.002)
+    assert np.allclose(got.R_ee_graspnet, want.R_ee_graspnet)
+    g, w = got.gripper, want.gripper
+    assert g.joints == w.joints and g.open == w.open and g.closed == w.closed
+    assert sorted(g.finger_links) == sorted(w.finger_links)
+    assert g.max_width == pytest.approx(w.max_width, abs=0.002)
+    # home is inside the limits (validate checked) and the marked guesses are in the file
+    assert "CHECK" in draft_path.read_text()
+    assert yaml.safe_load(draft_path.read_text())["urdf"] == "pybullet_data://franka_panda/panda.urdf"
+
+
+def test_never_overwrites_without_force(tmp_path, capsys, monkeypatch):
+    target = tmp_path / "mine.yaml"
+    target.write_text("keep me\n")
+    code, _, err = run_main(["new-robot", str(PANDA_URDF), "-o", str(target)], capsys, monkeypatch, tmp_path)
+    assert code == 2 and "--force" in err
+    assert target.read_text() == "keep me\n"
+    code, out, _ = run_main(["new-robot", str(PANDA_URDF), "-o", str(target), "--force"], capsys, monkeypatch, tmp_path)
+    assert code == 0, out
+    assert load_robot(target).config.name == "mine"
+
+
+def test_arm_without_gripper_and_a_relative_urdf(tmp_path):
+    d = draft_robot(parse_urdf(IIWA_URDF), "iiwa", tmp_path)
+    assert d.gripper is None and len(d.arm_joints) == 7 and d.ee_link == "lbr_iiwa_link_7"
+    assert any("no gripper" in n for n in d.notes)
+    # A URDF outside the known packages is referenced relative to the YAML's folder.
+    d = draft_robot(parse_urdf(KR210_URDF), "kr", tmp_path / "robots")
+    out = tmp_path / "robots" / "kr.yaml"
+    out.parent.mkdir()
+    out.write_text(render_yaml(d))
+    robot = load_robot(out)
+    assert robot.urdf_path == KR210_URDF.resolve()
+    assert robot.config.arms[0].joints == [f"joint_a{i}" for i in range(1, 7)]
+    assert robot.config.arms[0].ee_link == "suction_cup"  # the deepest rigid link (no gripper joints)
+    lo = [robot.urdf.joints[j].lower for j in robot.config.arms[0].joints]
+    hi = [robot.urdf.joints[j].upper for j in robot.config.arms[0].joints]
+    assert all(a <= h <= b for a, h, b in zip(lo, robot.config.arms[0].home, hi, strict=True))

@@ -1,0 +1,107 @@
+"""Robots added by YAML alone: an industrial arm on a pedestal, an arm + suction attachment, a
+dual-arm cell. One pick-place episode each really moves the object onto the place point."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from robocfg.checks import load_robot, load_task
+from robocfg.config import catalog
+from robocfg.runners.pick_place import run_pick_place
+
+
+class _ArmWatch:
+    """Stands in for a Recorder (``record=``) to read the world at the end of the episode."""
+
+    def __init__(self, world):
+        self.world, self.max_dev, self.at_end = world, {}, {}
+
+    def maybe_capture(self) -> None:
+        for name, arm in self.world.robot.arms.items():
+            dev = float(np.abs(arm.joint_positions() - arm.home).max())
+            self.max_dev[name] = max(self.max_dev.get(name, 0.0), dev)
+
+    def save(self) -> None:
+        self.at_end = {n: a.joint_positions() for n, a in self.world.robot.arms.items()}
+
+
+def _placed(report, task) -> None:
+    e = report.episodes[0]
+    assert e.success, (e.failed_phase, e.reason)
+    final = np.asarray(e.object_final)
+    assert np.linalg.norm(final[:2] - np.asarray(e.place_target)) <= task.config.pick_place.success_tolerance
+
+
+@pytest.mark.parametrize("arm", ["left", "right"])
+def test_dual_arm_cell_picks_with_either_arm_while_the_other_holds(arm):
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="dual_panda")
+    watches: list[_ArmWatch] = []
+
+    def record(world):
+        watches.append(_ArmWatch(world))
+        return watches[-1]
+
+    report, _ = run_pick_place(task, episodes=1, arm=arm, record=record)
+    _placed(report, task)
+    assert report.arm == arm
+    other = "right" if arm == "left" else "left"
+    w = watches[0]
+    assert w.max_dev[other] < 1e-3, f"the idle arm moved {w.max_dev[other]:.2e} rad"
+    assert w.max_dev[arm] > 0.3  # the working arm really moved
+
+
+def test_industrial_arm_on_a_yawed_pedestal_moves_a_heavy_box():
+    task = load_task(catalog.find("tasks", "pick_place_kuka_kr210"))
+    mount = task.config.robots[0]
+    assert task.config.scene.pedestal is not None and mount.position[2] == task.config.scene.pedestal.position[2]
+    assert mount.euler_deg[2] != 0.0  # yawed
+    obj = task.config.pick_place.object
+    assert obj.mass >= 5.0 and min(obj.size) >= 0.3
+    robot = task.robots[0].config
+    assert robot.arms[0].gripper.hold_force > 3 * obj.mass * 9.81  # sized for the box
+    report, _ = run_pick_place(task, episodes=1)
+    _placed(report, task)
+    e = report.episodes[0]
+    assert e.lift_rise > 0.5 * task.config.pick_place.lift_height
+    # the box moved a long way: pick and place are 1.4 m apart
+    assert math.dist(e.object_start[:2], e.place_target) > 1.0
+
+
+def test_arm_with_an_attached_suction_cup_runs_the_default_task():
+    robot = load_robot(catalog.find("robots", "kuka_iiwa_suction"))
+    assert "suction_cup" in robot.urdf.links and "lbr_iiwa_link_7" in robot.urdf.links  # composed
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="kuka_iiwa_suction")
+    report, _ = run_pick_place(task, episodes=1, seed=3)
+    _placed(report, task)
+
+
+def test_authored_kr210_urdf_has_data_sheet_kinematics():
+    """Reach 2.7 m (A1 axis to wrist centre, arm stretched horizontally), A2 at 0.675 m."""
+    robot = load_robot(catalog.find("robots", "kuka_kr210"))
+    urdf = robot.urdf
+    # stretched out horizontally: q2 = 90° (upper arm forward), q3 = −90° (forearm in line)
+    q = {"joint_a2": math.pi / 2, "joint_a3": -math.pi / 2}
+    a2 = urdf.link_pose("link_2", q)[:3, 3]
+    wrist = urdf.link_pose("link_5", q)[:3, 3]
+    assert a2[2] == pytest.approx(0.675) and a2[0] == pytest.approx(0.35)
+    assert wrist[0] == pytest.approx(2.70, abs=1e-6)
+    masses = [ln.mass for ln in urdf.links.values() if ln.mass]
+    assert 900 < sum(masses) < 1200  # the data sheet's ≈ 1.07 t
+
+
+def test_grasp_choice_avoids_a_far_ik_branch(monkeypatch):
+    """Episode 26 (seed 0) on the right arm: the grasp with the smaller wrist turn has its
+    pre-grasp IK answer on a flipped-shoulder branch (|Δq| ≈ 3 rad, 4.3 s of motion, past the
+    4 s timeout); the runner now takes the other top-down grasp (|Δq| ≈ 1.7 rad)."""
+    import robocfg.runners.pick_place as pp
+
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="dual_panda")
+    all_setups = pp.episode_setups(task.config.pick_place, 0, 27)
+    monkeypatch.setattr(pp, "episode_setups", lambda params, seed, episodes: [all_setups[26]])
+    report, _ = run_pick_place(task, episodes=1, arm="right")
+    _placed(report, task)
+    pre = report.episodes[0].phases[0]
+    assert pre.name == "pre_grasp" and pre.t_end - pre.t_start < 4.0
