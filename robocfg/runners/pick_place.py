@@ -34,6 +34,7 @@ IK_ITERATIONS = 400  # LM iterations per IK query, over all restarts: the budget
 IK_TIME_CAP = 1.0  # s of wall clock per IK query: only a safety net, never reached on a sane machine
 SETTLE_POLL = 4  # physics steps between convergence checks
 RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
+DIRECT_TRAVEL_CHECK = 1.0  # rad: a point-to-point IK answer this far away is compared with a continuous one
 MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
 SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
 
@@ -113,7 +114,7 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
                                                            acceleration_scale=params.speed_scale)),
         )
         for setup in episode_setups(params, seed, episodes):
-            t0 = time.perf_counter()
+            t0, physics0 = time.perf_counter(), world.physics_seconds
             if setup.body.name in world.bodies:
                 world.remove_body(setup.body.name)
             world.restore(state)
@@ -129,6 +130,7 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
                 recorder.save()
             res = sm.result(failed, reason)
             timing.per_episode.append(time.perf_counter() - t0)
+            timing.physics_per_episode.append(world.physics_seconds - physics0)
             results.append(res)
             if on_episode:
                 on_episode(res)
@@ -263,24 +265,24 @@ class _StateMachine:
         return res.q
 
     def _move(self, T_goal: np.ndarray, straight: bool, check_held: bool = False) -> None:
+        """Move ``ee_link`` to ``T_goal``: along a straight TCP line (IK with continuity every
+        CARTESIAN_STEP), or point to point in joint space to the IK answer nearest the current
+        joints (of the direct answer and the end of a continuous line, the one with less travel)."""
         from robocfg.motion.minjerk_path import MinJerkPath
 
         q0 = self.arm.joint_positions()
-        T0 = self.model.fk(q0, "ee")
         if straight:
-            n = max(2, math.ceil(np.linalg.norm(T_goal[:3, 3] - T0[:3, 3]) / CARTESIAN_STEP) + 1)
-            waypoints, q = [q0], q0
-            for s in np.linspace(0, 1, n)[1:]:
-                T = T_goal.copy()
-                T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
-                q_next = self._solve(T, q, f" at {s:.0%} of the straight line")
-                if np.max(np.abs(q_next - q)) > MAX_JOINT_JUMP:
-                    raise PhaseFailed(self.phase, f"no continuous IK along the straight line (a joint jumps "
-                                                  f"{np.max(np.abs(q_next - q)):.2f} rad at {s:.0%})")
-                q = q_next
-                waypoints.append(q)
+            waypoints = self._line_ik(q0, T_goal)
         else:
-            waypoints = [q0, self._solve(T_goal, q0, "")]
+            q_goal = self._solve(T_goal, q0, "")
+            if np.max(np.abs(q_goal - q0)) > DIRECT_TRAVEL_CHECK:
+                try:
+                    q_line = self._line_ik(q0, T_goal)[-1]
+                    if np.max(np.abs(q_line - q0)) < np.max(np.abs(q_goal - q0)):
+                        q_goal = q_line
+                except PhaseFailed:
+                    pass
+            waypoints = [q0, q_goal]
         W = np.asarray(waypoints)
         if np.max(np.abs(W[-1] - W[0])) < 1e-6:
             return
@@ -292,6 +294,23 @@ class _StateMachine:
         self._converge(T_goal, t_start)
         if check_held and not self._held():
             raise PhaseFailed(self.phase, f"object dropped ({self._object_to_tcp() * 100:.1f} cm from the TCP)")
+
+    def _line_ik(self, q0: np.ndarray, T_goal: np.ndarray) -> list[np.ndarray]:
+        """Joint waypoints along the straight line from the current EE pose to ``T_goal`` (the
+        orientation is ``T_goal``'s throughout), each IK seeded with the previous answer."""
+        T0 = self.model.fk(q0, "ee")
+        n = max(2, math.ceil(np.linalg.norm(T_goal[:3, 3] - T0[:3, 3]) / CARTESIAN_STEP) + 1)
+        waypoints, q = [q0], q0
+        for s in np.linspace(0, 1, n)[1:]:
+            T = T_goal.copy()
+            T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
+            q_next = self._solve(T, q, f" at {s:.0%} of the straight line")
+            if np.max(np.abs(q_next - q)) > MAX_JOINT_JUMP:
+                raise PhaseFailed(self.phase, f"no continuous IK along the straight line (a joint jumps "
+                                              f"{np.max(np.abs(q_next - q)):.2f} rad at {s:.0%})")
+            waypoints.append(q_next)
+            q = q_next
+        return waypoints
 
     def _play(self, traj) -> None:
         """Send the trajectory's position and velocity targets every physics step (no tracking

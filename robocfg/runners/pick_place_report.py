@@ -67,6 +67,12 @@ class PickPlaceTiming:
 
     wall_time: float = 0.0
     per_episode: list[float] = field(default_factory=list)
+    physics_per_episode: list[float] = field(default_factory=list)  # s inside p.stepSimulation
+
+    @property
+    def mean_physics(self) -> float:
+        n = len(self.physics_per_episode)
+        return sum(self.physics_per_episode) / n if n else 0.0
 
     @property
     def mean_episode(self) -> float:

@@ -19,6 +19,7 @@ import contextlib
 import math
 import os
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -54,6 +55,7 @@ class World:
         self.dt: float = cfg.sim.timestep
         self.t: float = 0.0
         self.steps = 0
+        self.physics_seconds = 0.0  # wall-clock time spent inside p.stepSimulation (for benchmarks)
         self.max_joint_velocity, self.max_body_speed = max_joint_velocity, max_body_speed
         self._check_every = max(1, round(check_interval / self.dt))
         self.warnings: list[str] = []
@@ -234,9 +236,11 @@ class World:
     # ---- stepping -----------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance ``n`` physics steps of ``dt``; grippers update after each; divergence raises."""
-        c = self.client
+        c, clock = self.client, time.perf_counter
         for _ in range(n):
+            t0 = clock()
             p.stepSimulation(physicsClientId=c)
+            self.physics_seconds += clock() - t0
             self.steps += 1
             self.t = self.steps * self.dt
             for g in self._grippers:
