@@ -2,9 +2,10 @@
 
 Every target comes from the robot YAML through one conversion (design.md §3): a top-down
 GraspNet grasp (approach straight down, fingers closing across the object's narrower horizontal
-side) → ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``) → IK → a
-time-optimal joint trajectory (toppra through IK waypoints along straight TCP lines) → position
-drives. The object is held by friction only (parallel grippers) or by the suction cup.
+side) → ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``) → IK (continuous
+along straight TCP lines) → min-jerk timed joint trajectories → position drives, all through
+:class:`robocfg.motion.moves.ArmMover`. The object is held by friction only (parallel grippers)
+or by the suction cup.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import Limits, PickPlaceParams
 from robocfg.config.scene import Body
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, rotation_angle, top_down_grasps
+from robocfg.motion.moves import ArmMover, MoveFailed, bound_ik_by_iterations
 from robocfg.runners.pick_place_report import (
     EpisodeResult,
     PhaseRecord,
@@ -29,20 +31,9 @@ from robocfg.runners.pick_place_report import (
 )
 
 Log = Callable[[str], None]
-CARTESIAN_STEP = 0.03  # m between IK waypoints on straight TCP lines
-IK_ITERATIONS = 400  # LM iterations per IK query, over all restarts: the budget that binds (deterministic)
-IK_TIME_CAP = 1.0  # s of wall clock per IK query: only a safety net, never reached on a sane machine
-SETTLE_POLL = 4  # physics steps between convergence checks
+SETTLE_POLL = 4  # physics steps between checks while waiting
 RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
-DIRECT_TRAVEL_CHECK = 1.0  # rad: a point-to-point IK answer this far away is compared with a continuous one
-MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
 SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
-
-
-class PhaseFailed(Exception):
-    def __init__(self, phase: str, reason: str):
-        self.phase, self.reason = phase, reason
-        super().__init__(f"{phase}: {reason}")
 
 
 @dataclass(frozen=True)
@@ -105,9 +96,7 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
         state = world.snapshot()
         handle = world.robot.arm(arm_cfg.name)
         model = KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=world.robot.base_pose())
-        solver = model.solver()
-        if hasattr(solver, "max_total_iter"):  # an iteration budget keeps answers independent of machine load
-            solver.max_total_iter = IK_ITERATIONS
+        bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
         tools = _Tools(
             model,
             limits_from_robot(robot, handle.joints, Limits(velocity_scale=params.speed_scale,
@@ -123,7 +112,7 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
             try:
                 sm.run()
                 failed, reason = None, "placed"
-            except PhaseFailed as exc:
+            except MoveFailed as exc:
                 failed, reason = exc.phase, exc.reason
                 sm.close_phase(False, reason)
             if recorder is not None:
@@ -154,7 +143,9 @@ class _StateMachine:
         self.world, self.params, self.setup, self.recorder = world, params, setup, recorder
         self.log = log or (lambda _msg: None)
         self.arm, self.cfg, self.gripper = arm, arm.config, arm.gripper
-        self.model, self.limits = tools.model, tools.limits
+        self.model = tools.model
+        self.mover = ArmMover(world, arm, tools.model, tools.limits, params.position_tolerance,
+                              params.orientation_tolerance, on_step=self._on_step, phase="setup")
         if params.grip_force is not None and hasattr(self.gripper, "set_force"):
             self.gripper.set_force(params.grip_force)
         self.obj = world.add_body(setup.body)
@@ -165,8 +156,8 @@ class _StateMachine:
     # ---- phases ------------------------------------------------------------------------------
     def run(self) -> None:
         p = self.params
-        self._open_gripper()
-        self._settle(0.2)
+        self.gripper.open()
+        self.mover.settle(0.2)
         obj_pos, _ = self.world.body_pose(self.obj)
         self.support_z = obj_pos[2] - self.setup.body.half_height()
         if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
@@ -178,15 +169,15 @@ class _StateMachine:
         T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
 
         self.begin("pre_grasp", "move above the object")
-        self._move(T_pre, straight=False)
+        self.mover.move(T_pre, straight=False)
         self.begin("approach", "down to grasp height")
-        self._move(T_grasp, straight=True)
+        self.mover.move(T_grasp, straight=True)
         self.begin("grasp", "close the gripper")
-        self._grasp()
+        self.mover.close_until_held(self.obj, self.mover.timeout)
         self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
         z0 = self.world.body_pose(self.obj)[0][2]
         T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
-        self._move(T_lift, straight=True)
+        self.mover.move(T_lift, straight=True)
         self._verify_lift(z0)
         # Carry the object so that *it* lands on the place point: keep its offset from the EE.
         obj_now = self.world.body_pose(self.obj)[0]
@@ -199,21 +190,22 @@ class _StateMachine:
         T_above_place = T_place.copy()
         T_above_place[2, 3] = max(T_lift[2, 3], T_place[2, 3] + p.lift_height)
         self.begin("transport", "carry above the place point")
-        self._move(T_above_place, straight=False, check_held=True)
+        self.mover.move(T_above_place, straight=False, check=self._dropped)
         self.begin("lower", "lower onto the support")
-        self._move(T_place, straight=True, check_held=True)
+        self.mover.move(T_place, straight=True, check=self._dropped)
         self.begin("release", "open the gripper")
         self._release()
         self.begin("retract", "move up and away")
-        self._move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
+        self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
         self.close_phase(True)
-        self._settle(0.3)
+        self.mover.settle(0.3)
         self._check_placed()
 
     def begin(self, name: str, what: str) -> None:
         if self._phase is not None:
             self.close_phase(True)
         self._phase = (name, self.world.t)
+        self.mover.phase, self.mover.timeout = name, getattr(self.params.timeouts, name)
         n = len(self.phases) + 1
         self.log(f"Phase {n}: {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
 
@@ -223,13 +215,6 @@ class _StateMachine:
         name, t0 = self._phase
         self.phases.append(PhaseRecord(name, round(t0, 6), round(self.world.t, 6), ok, detail))
         self._phase = None
-
-    @property
-    def phase(self) -> str:
-        return self._phase[0] if self._phase else "setup"
-
-    def timeout(self) -> float:
-        return getattr(self.params.timeouts, self.phase)
 
     # ---- motion ------------------------------------------------------------------------------
     def _choose_grasp(self, center: np.ndarray) -> Grasp:
@@ -249,7 +234,7 @@ class _StateMachine:
             T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
             cost, q = 0.0, q0
             for T in (T_pre, _shifted(T_pre, shift)):
-                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=IK_TIME_CAP)
+                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
                 if not res.converged:
                     return math.inf
                 cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
@@ -258,113 +243,19 @@ class _StateMachine:
         costs = [travel(g) for g in cands]
         return cands[int(np.argmin(costs))] if min(costs) < math.inf else cands[0]
 
-    def _solve(self, T: np.ndarray, seed: np.ndarray, what: str) -> np.ndarray:
-        res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=IK_TIME_CAP)
-        if not res.converged:
-            raise PhaseFailed(self.phase, f"unreachable{what} (residual {res.pos_err * 1000:.1f} mm, {math.degrees(res.rot_err):.1f}°)")
-        return res.q
-
-    def _move(self, T_goal: np.ndarray, straight: bool, check_held: bool = False) -> None:
-        """Move ``ee_link`` to ``T_goal``: along a straight TCP line (IK with continuity every
-        CARTESIAN_STEP), or point to point in joint space to the IK answer nearest the current
-        joints (of the direct answer and the end of a continuous line, the one with less travel)."""
-        from robocfg.motion.minjerk_path import MinJerkPath
-
-        q0 = self.arm.joint_positions()
-        if straight:
-            waypoints = self._line_ik(q0, T_goal)
-        else:
-            q_goal = self._solve(T_goal, q0, "")
-            if np.max(np.abs(q_goal - q0)) > DIRECT_TRAVEL_CHECK:
-                try:
-                    q_line = self._line_ik(q0, T_goal)[-1]
-                    if np.max(np.abs(q_line - q0)) < np.max(np.abs(q_goal - q0)):
-                        q_goal = q_line
-                except PhaseFailed:
-                    pass
-            waypoints = [q0, q_goal]
-        W = np.asarray(waypoints)
-        if np.max(np.abs(W[-1] - W[0])) < 1e-6:
-            return
-        traj = MinJerkPath(W, self.limits)
-        if traj.duration > self.timeout():
-            raise PhaseFailed(self.phase, f"motion needs {traj.duration:.2f} s, more than the {self.timeout():.2f} s timeout")
-        t_start = self.world.t
-        self._play(traj)
-        self._converge(T_goal, t_start)
-        if check_held and not self._held():
-            raise PhaseFailed(self.phase, f"object dropped ({self._object_to_tcp() * 100:.1f} cm from the TCP)")
-
-    def _line_ik(self, q0: np.ndarray, T_goal: np.ndarray) -> list[np.ndarray]:
-        """Joint waypoints along the straight line from the current EE pose to ``T_goal`` (the
-        orientation is ``T_goal``'s throughout), each IK seeded with the previous answer."""
-        T0 = self.model.fk(q0, "ee")
-        n = max(2, math.ceil(np.linalg.norm(T_goal[:3, 3] - T0[:3, 3]) / CARTESIAN_STEP) + 1)
-        waypoints, q = [q0], q0
-        for s in np.linspace(0, 1, n)[1:]:
-            T = T_goal.copy()
-            T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
-            q_next = self._solve(T, q, f" at {s:.0%} of the straight line")
-            if np.max(np.abs(q_next - q)) > MAX_JOINT_JUMP:
-                raise PhaseFailed(self.phase, f"no continuous IK along the straight line (a joint jumps "
-                                              f"{np.max(np.abs(q_next - q)):.2f} rad at {s:.0%})")
-            waypoints.append(q_next)
-            q = q_next
-        return waypoints
-
-    def _play(self, traj) -> None:
-        """Send the trajectory's position and velocity targets every physics step (no tracking
-        statistics: the per-step cost stays at one motor call)."""
-        dt = self.world.dt
-        n = math.ceil(traj.duration / dt - 1e-9)
-        q_ref, qd_ref, _ = traj.evaluate(np.arange(1, n + 1) * dt)
-        for k in range(n):
-            self.arm.command(q_ref[k], qd_ref[k])
-            self.world.step()
-            self._on_step()
-
-    def _converge(self, T_goal: np.ndarray, t_start: float) -> None:
-        p = self.params
-        while True:
-            T = self.arm.ee_pose()
-            dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
-            dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
-            if dp <= p.position_tolerance and dr <= p.orientation_tolerance:
-                return
-            if self.world.t - t_start > self.timeout():
-                raise PhaseFailed(self.phase, f"did not converge within {self.timeout():.1f} s (error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
-            self._step(SETTLE_POLL)
-
-    # ---- gripper -----------------------------------------------------------------------------
-    def _open_gripper(self) -> None:
-        self.gripper.open()
-
-    def _grasp(self) -> None:
-        """Close; wait until the object is held and a measured finger width (if any) is still."""
-        t0 = self.world.t
-        self.gripper.close()
-        measure = getattr(self.gripper, "width", None)
-        last, still = (measure() if measure else 0.0), 0.0
-        while not (self._held() and (measure is None or still >= 0.1)):
-            self._step(SETTLE_POLL)
-            if measure is not None:
-                w = measure()
-                still = still + SETTLE_POLL * self.world.dt if abs(w - last) < 2e-4 else 0.0
-                last = w
-            if self.world.t - t0 > self.timeout():
-                if self._held():
-                    return
-                width = f" (width {measure() * 1000:.1f} mm)" if measure else ""
-                raise PhaseFailed("grasp", f"the object is not held{width}")
-
     def _release(self) -> None:
         t0 = self.world.t
-        self._open_gripper()
+        self.gripper.open()
         opening = getattr(self.gripper, "fraction", None)
         while self._held() or (opening is not None and opening() < 0.9):
-            if self.world.t - t0 > self.timeout():
-                raise PhaseFailed("release", "the object did not come free")
-            self._step(SETTLE_POLL)
+            if self.world.t - t0 > self.mover.timeout:
+                raise MoveFailed("release", "the object did not come free")
+            self.mover.step(SETTLE_POLL)
+
+    def _dropped(self) -> str | None:
+        if self._held():
+            return None
+        return f"object dropped ({self._object_to_tcp() * 100:.1f} cm from the TCP)"
 
     def _held(self) -> bool:
         return bool(self.gripper.is_grasping(self.obj))
@@ -378,20 +269,12 @@ class _StateMachine:
         want = 0.5 * self.params.lift_height
         if not self._held() or self.lift_rise < want:
             below = self.arm.tcp_pose()[2, 3] - z1
-            raise PhaseFailed("lift", f"object slipped, {below * 100:.1f} cm below the fingers (rose {self.lift_rise * 100:.1f} cm)")
+            raise MoveFailed("lift", f"object slipped, {below * 100:.1f} cm below the fingers (rose {self.lift_rise * 100:.1f} cm)")
 
     # ---- world helpers -----------------------------------------------------------------------
     def _on_step(self) -> None:
         if self.recorder is not None:
             self.recorder.maybe_capture()
-
-    def _step(self, n: int) -> None:
-        for _ in range(n):
-            self.world.step()
-            self._on_step()
-
-    def _settle(self, seconds: float) -> None:
-        self._step(round(seconds / self.world.dt))
 
     def _support_height(self, xy: np.ndarray) -> float:
         """Height (m) of the first surface below ``xy`` that is not the robot or the object."""
@@ -414,11 +297,11 @@ class _StateMachine:
         tilt = self._tilt(quat)
         rest_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height()
         if err > p.success_tolerance:
-            raise PhaseFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
+            raise MoveFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
         if tilt > p.max_tilt_deg:
-            raise PhaseFailed("place", f"object tilted {tilt:.1f}° (max {p.max_tilt_deg:.0f}°)")
+            raise MoveFailed("place", f"object tilted {tilt:.1f}° (max {p.max_tilt_deg:.0f}°)")
         if abs(pos[2] - rest_z) > 0.01:
-            raise PhaseFailed("place", f"object not resting on the support (centre {pos[2] * 100:.1f} cm, expected {rest_z * 100:.1f} cm)")
+            raise MoveFailed("place", f"object not resting on the support (centre {pos[2] * 100:.1f} cm, expected {rest_z * 100:.1f} cm)")
 
     @staticmethod
     def _tilt(quat) -> float:

@@ -1,0 +1,174 @@
+"""Arm moves shared by the grasping runners: IK to EE poses (continuous along straight lines),
+min-jerk timing, trajectory following, convergence checks, and close-until-held.
+
+Used by pick-place and grasp: ``ArmMover.move(T_goal, straight=...)`` plans IK waypoints every
+``CARTESIAN_STEP`` m along a straight EE line (or, for a joint-space move, the IK answer nearest
+the current joints), times them with ``MinJerkPath``, sends position + velocity targets every
+physics step, and waits until the EE is within tolerance. Failures raise
+``MoveFailed(phase, reason)``. Poses are world_T_ee (4x4, m).
+
+IK is bounded by an iteration budget (``bound_ik_by_iterations``) rather than wall-clock time, so
+the same seed gives the same answers whatever the machine load; ``ik_budget`` (s) is a safety net.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.kinematics.frames import rotation_angle
+
+CARTESIAN_STEP = 0.03  # m between IK waypoints on straight lines
+SETTLE_POLL = 4  # physics steps between convergence checks
+MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
+DIRECT_TRAVEL_CHECK = 1.0  # rad: a point-to-point IK answer this far away is compared with a continuous one
+IK_ITERATIONS = 400  # LM iterations per IK query over all restarts (see bound_ik_by_iterations)
+
+
+def bound_ik_by_iterations(model, iterations: int = IK_ITERATIONS) -> None:
+    """Make ``model``'s IK solver stop after ``iterations`` iterations (all restarts included)
+    instead of when its time budget runs out, where the backend supports it (``lm`` does)."""
+    solver = model.solver()
+    if hasattr(solver, "max_total_iter"):
+        solver.max_total_iter = iterations
+
+
+class MoveFailed(Exception):
+    """A phase could not be completed: ``phase`` name and a one-line ``reason``."""
+
+    def __init__(self, phase: str, reason: str):
+        self.phase, self.reason = phase, reason
+        super().__init__(f"{phase}: {reason}")
+
+
+@dataclass
+class ArmMover:
+    """Moves one arm of ``world``. ``model``: KinematicModel of the arm; ``limits``: JointLimits
+    for timing; tolerances in m and rad; ``timeout`` (s) per move; ``on_step`` after every physics
+    step (e.g. a recorder); ``phase`` names the current phase in failures."""
+
+    world: object
+    arm: object
+    model: object
+    limits: object
+    position_tolerance: float = 0.005
+    orientation_tolerance: float = 0.05
+    timeout: float = 4.0
+    on_step: Callable[[], None] | None = None
+    phase: str = "move"
+    ik_budget: float = 1.0  # s of wall clock per IK query: a safety net (bound_ik_by_iterations binds)
+
+    def solve(self, T: np.ndarray, seed: np.ndarray, what: str = "") -> np.ndarray:
+        res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
+        if not res.converged:
+            raise MoveFailed(self.phase, f"unreachable{what} (residual {res.pos_err * 1000:.1f} mm, "
+                                         f"{math.degrees(res.rot_err):.1f}°)")
+        return res.q
+
+    def straight_waypoints(self, q0: np.ndarray, T_goal: np.ndarray) -> np.ndarray:
+        """Joint waypoints along the straight EE line from FK(q0) to ``T_goal`` (orientation of the goal)."""
+        T0 = self.model.fk(q0, "ee")
+        n = max(2, math.ceil(np.linalg.norm(T_goal[:3, 3] - T0[:3, 3]) / CARTESIAN_STEP) + 1)
+        waypoints, q = [q0], q0
+        for s in np.linspace(0, 1, n)[1:]:
+            T = T_goal.copy()
+            T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
+            q_next = self.solve(T, q, f" at {s:.0%} of the straight line")
+            jump = float(np.max(np.abs(q_next - q)))
+            if jump > MAX_JOINT_JUMP:
+                raise MoveFailed(self.phase, f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at {s:.0%})")
+            q = q_next
+            waypoints.append(q)
+        return np.asarray(waypoints)
+
+    def move(self, T_goal: np.ndarray, straight: bool, q_goal: np.ndarray | None = None,
+             check: Callable[[], str | None] | None = None) -> None:
+        """Go to ``T_goal``; ``q_goal`` (a known IK answer) skips the IK of a joint-space move.
+        A joint-space move takes, of the direct IK answer and the end of a continuous straight
+        line, the one with less joint travel (IK may land on a far branch). ``check()`` runs at
+        the end and returns a failure reason or None."""
+        from robocfg.motion.minjerk_path import MinJerkPath
+
+        q0 = self.arm.joint_positions()
+        if straight:
+            W = self.straight_waypoints(q0, T_goal)
+        else:
+            if q_goal is None:
+                q_goal = self.solve(T_goal, q0)
+                if np.max(np.abs(q_goal - q0)) > DIRECT_TRAVEL_CHECK:
+                    try:
+                        q_line = self.straight_waypoints(q0, T_goal)[-1]
+                        if np.max(np.abs(q_line - q0)) < np.max(np.abs(q_goal - q0)):
+                            q_goal = q_line
+                    except MoveFailed:
+                        pass
+            W = np.asarray([q0, q_goal])
+        if np.max(np.abs(W[-1] - W[0])) >= 1e-6:
+            traj = MinJerkPath(W, self.limits)
+            if traj.duration > self.timeout:
+                raise MoveFailed(self.phase, f"motion needs {traj.duration:.2f} s, more than the {self.timeout:.2f} s timeout")
+            t_start = self.world.t
+            self.play(traj)
+            self.converge(T_goal, t_start)
+        if check is not None:
+            reason = check()
+            if reason:
+                raise MoveFailed(self.phase, reason)
+
+    def play(self, traj) -> None:
+        """Send the trajectory's position and velocity targets every physics step (no tracking
+        statistics, so the per-step cost stays at one motor call)."""
+        dt = self.world.dt
+        n = math.ceil(traj.duration / dt - 1e-9)
+        q_ref, qd_ref, _ = traj.evaluate(np.arange(1, n + 1) * dt)
+        for k in range(n):
+            self.arm.command(q_ref[k], qd_ref[k])
+            self.step(1)
+
+    def converge(self, T_goal: np.ndarray, t_start: float) -> None:
+        while True:
+            T = self.arm.ee_pose()
+            dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
+            dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
+            if dp <= self.position_tolerance and dr <= self.orientation_tolerance:
+                return
+            if self.world.t - t_start > self.timeout:
+                raise MoveFailed(self.phase, f"did not converge within {self.timeout:.1f} s "
+                                             f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
+            self.step(SETTLE_POLL)
+
+    def close_until_held(self, body: int, timeout: float) -> None:
+        """Close the gripper; wait until both fingers touch ``body`` and the measured width is still
+        for 0.1 s (or ``timeout`` s pass: then it must at least be held)."""
+        g = self.arm.gripper
+        t0 = self.world.t
+        g.close()
+        measure = getattr(g, "width", None)
+        last, still = (measure() if measure else 0.0), 0.0
+        while not (g.is_grasping(body) and (measure is None or still >= 0.1)):
+            self.step(SETTLE_POLL)
+            if measure is not None:
+                w = measure()
+                still = still + SETTLE_POLL * self.world.dt if abs(w - last) < 2e-4 else 0.0
+                last = w
+            if self.world.t - t0 > timeout:
+                if g.is_grasping(body):
+                    return
+                width = f" (width {measure() * 1000:.1f} mm)" if measure else ""
+                raise MoveFailed(self.phase, f"the object is not held{width}")
+
+    def open_gripper(self, seconds: float = 0.4) -> None:
+        self.arm.gripper.open()
+        self.settle(seconds)
+
+    def step(self, n: int) -> None:
+        for _ in range(n):
+            self.world.step()
+            if self.on_step is not None:
+                self.on_step()
+
+    def settle(self, seconds: float) -> None:
+        self.step(round(seconds / self.world.dt))

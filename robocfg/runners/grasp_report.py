@@ -1,0 +1,101 @@
+"""Typed results of ``run grasp``. The JSON report holds no wall-clock figures (same seed ⇒ same
+JSON); planning and perception times are kept apart in ``GraspTiming``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class AttemptRecord:
+    """One grasp attempt: the candidate tried (GraspNet frame, world m), and how it ended."""
+
+    candidate: dict
+    rank: int
+    success: bool
+    failed_phase: str | None
+    reason: str
+
+
+@dataclass
+class GraspEpisode:
+    """One episode. ``object_start``: x, y (m), yaw (deg); ``rejected``: candidate counts per
+    rejection reason in the first plan; ``lift_rise``: how far the object rose (m)."""
+
+    index: int
+    seed: int
+    object: str
+    object_start: list[float]
+    success: bool
+    first_attempt_success: bool
+    failed_phase: str | None
+    reason: str
+    object_points: int
+    poses_evaluated: int
+    candidates: int
+    rejected: dict[str, int]
+    chosen_score: float | None
+    lift_rise: float | None
+    sim_time: float
+    attempts: list[AttemptRecord] = field(default_factory=list)
+
+
+@dataclass
+class GraspSummary:
+    episodes: int
+    successes: int
+    success_rate: float
+    first_attempt_rate: float
+    mean_attempts: float
+    by_object: dict[str, str]
+    failures_by_phase: dict[str, int]
+
+
+@dataclass
+class GraspReport:
+    task: str
+    robot: str
+    arm: str
+    seed: int
+    summary: GraspSummary
+    episodes: list[GraspEpisode]
+    warnings: list[str] = field(default_factory=list)
+
+
+@dataclass
+class GraspTiming:
+    """Wall times (s): ``planning`` per plan (sampling → ranked reachable grasps), ``perception``
+    per capture (rendering + cloud), ``per_episode``, ``wall_time`` overall."""
+
+    planning: list[float] = field(default_factory=list)
+    perception: list[float] = field(default_factory=list)
+    per_episode: list[float] = field(default_factory=list)
+    wall_time: float = 0.0
+
+    @property
+    def median_planning(self) -> float:
+        return float(np.median(self.planning)) if self.planning else 0.0
+
+    @property
+    def median_perception(self) -> float:
+        return float(np.median(self.perception)) if self.perception else 0.0
+
+
+def summarise(episodes: list[GraspEpisode]) -> GraspSummary:
+    n = len(episodes)
+    ok = sum(e.success for e in episodes)
+    by: dict[str, list[int]] = {}
+    fails: dict[str, int] = {}
+    for e in episodes:
+        by.setdefault(e.object, [0, 0])
+        by[e.object][0] += e.success
+        by[e.object][1] += 1
+        if not e.success:
+            fails[e.failed_phase or "?"] = fails.get(e.failed_phase or "?", 0) + 1
+    return GraspSummary(
+        episodes=n, successes=ok, success_rate=round(ok / n, 6) if n else 0.0,
+        first_attempt_rate=round(sum(e.first_attempt_success for e in episodes) / n, 6) if n else 0.0,
+        mean_attempts=round(sum(len(e.attempts) for e in episodes) / n, 4) if n else 0.0,
+        by_object={k: f"{v[0]}/{v[1]}" for k, v in by.items()}, failures_by_phase=fails)
