@@ -20,18 +20,22 @@ app = typer.Typer(
 )
 
 
-@app.callback()
-def _root(
-    debug: bool = typer.Option(False, "--debug", help="Show Python tracebacks on errors."),
-    version: bool = typer.Option(False, "--version", help="Print the version and exit."),
-) -> None:
-    if debug:
-        os.environ["ROBOCFG_DEBUG"] = "1"
-    if version:
+def _print_version(value: bool) -> None:
+    if value:
         from robocfg import __version__
 
         typer.echo(__version__)
         raise typer.Exit(0)
+
+
+@app.callback()
+def _root(
+    debug: bool = typer.Option(False, "--debug", help="Show Python tracebacks on errors."),
+    version: bool = typer.Option(False, "--version", help="Print the version and exit.",
+                                 callback=_print_version, is_eager=True),
+) -> None:
+    if debug:
+        os.environ["ROBOCFG_DEBUG"] = "1"
 
 
 app.command("validate")(validate.validate)
