@@ -52,3 +52,49 @@ def _default(o: Any) -> Any:
     if isinstance(o, Path):
         return str(o)
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
+
+
+def load_task_for(task: str, kind: str, command: str, robot: str | None = None):
+    """Find and check a task YAML by name or path; it must be a ``task: <kind>`` file."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.errors import ConfigError
+
+    checked = load_task(catalog.find("tasks", task), robot_override=robot)
+    if checked.config.task != kind:
+        raise ConfigError([checked.doc.problem(("task",), f"'run {command}' needs a 'task: {kind}' file, "
+                                                         f"this is 'task: {checked.config.task}'")])
+    return checked
+
+
+def run_and_report(run, json_path: Path | None, quiet: bool, full, one_line) -> int:
+    """Call ``run()``; write its result as JSON (also the partial report of a failed run) and print
+    it: ``one_line(result)`` with ``-q``, ``full(result)`` otherwise. A failure is re-raised."""
+    from robocfg.errors import RunFailed
+
+    try:
+        result = run()
+    except RunFailed as exc:
+        if exc.report is not None:
+            write_json(json_path, exc.report)
+            if not quiet:
+                full(exc.report)
+        raise
+    write_json(json_path, result)
+    if quiet:
+        console().print(one_line(result), markup=False)
+    else:
+        full(result)
+    return 0
+
+
+def key_value_table(title: str, rows: list[tuple[str, str]]):
+    """A two-column rich table (no header) of ``(key, value)`` rows."""
+    from rich.table import Table
+
+    table = Table(title=title, show_header=False)
+    table.add_column("key")
+    table.add_column("value")
+    for k, v in rows:
+        table.add_row(k, v)
+    return table

@@ -7,7 +7,16 @@ from typing import Annotated
 
 import typer
 
-from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, console, write_json
+from robocfg.cli.common import (
+    GuiOpt,
+    JsonOpt,
+    QuietOpt,
+    RecordOpt,
+    RobotOpt,
+    console,
+    load_task_for,
+    run_and_report,
+)
 
 PlotOpt = Annotated[Path | None, typer.Option("--plot", help="Save a plot (.png) of tracking error and clearance against time.", dir_okay=False)]
 WithObstacleOpt = Annotated[bool | None, typer.Option("--with-obstacle/--without-obstacle",
@@ -26,33 +35,14 @@ def run_follow_target(
 ) -> int:
     """Track a static / waypoint / circle / figure-8 target with a QP per control step (placo), keeping
     the safety margin from obstacles, table and ground. With --gui, drag the target with the sliders."""
-    from robocfg.checks import load_task
-    from robocfg.config import catalog
-    from robocfg.config.task import FollowTargetTask
-    from robocfg.errors import ConfigError, RunFailed
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
     from robocfg.runners.follow_target import run_follow_target as run
 
-    checked = load_task(catalog.find("tasks", task), robot_override=robot)
-    if not isinstance(checked.config, FollowTargetTask):
-        raise ConfigError([checked.doc.problem(("task",), f"'run follow-target' needs a 'task: follow_target' file, "
-                                                         f"this is 'task: {checked.config.task}'")])
-    try:
-        result = run(checked, gui=gui, with_obstacle=with_obstacle, record=record, plot=plot)
-    except RunFailed as exc:
-        if exc.report is not None:
-            write_json(json_path, exc.report)
-            if not quiet:
-                _print(exc.report)
-        raise
-    write_json(json_path, result)
-    if quiet:
-        console().print(_one_line(result))
-    else:
-        _print(result)
-    return 0
+    checked = load_task_for(task, "follow_target", "follow-target", robot)
+    return run_and_report(lambda: run(checked, gui=gui, with_obstacle=with_obstacle, record=record, plot=plot),
+                          json_path, quiet, _print, _one_line)
 
 
 def _f(v: float | None, unit: str, digits: int = 2) -> str:

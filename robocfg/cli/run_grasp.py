@@ -7,7 +7,17 @@ from typing import Annotated
 
 import typer
 
-from robocfg.cli.common import JsonOpt, QuietOpt, RecordOpt, RobotOpt, SeedOpt, console, write_json
+from robocfg.cli.common import (
+    JsonOpt,
+    QuietOpt,
+    RecordOpt,
+    RobotOpt,
+    SeedOpt,
+    console,
+    key_value_table,
+    load_task_for,
+    write_json,
+)
 
 
 def run_grasp(
@@ -32,9 +42,6 @@ def run_grasp(
     Exit 0 when the lift success rate reaches --min-success, 1 otherwise (no object points in the
     workspace, no feasible grasp, or the object was not held). --record draws the candidate grasps.
     """
-    from robocfg.checks import load_task
-    from robocfg.config import catalog
-    from robocfg.config.task import GraspTask
     from robocfg.errors import ConfigError, Problem, RunFailed
     from robocfg.sim.quiet import quiet_import
 
@@ -44,10 +51,7 @@ def run_grasp(
     from robocfg.runners.grasp import EpisodeFailed
     from robocfg.runners.grasp import run_grasp as run
 
-    checked = load_task(catalog.find("tasks", task), robot_override=robot)
-    if not isinstance(checked.config, GraspTask):
-        raise ConfigError([checked.doc.problem(("task",), f"'run grasp' needs a 'task: grasp' file, "
-                                                         f"this is 'task: {checked.config.task}'")])
+    checked = load_task_for(task, "grasp", "grasp", robot)
     if not checked.config.grasp.objects:
         raise ConfigError([checked.doc.problem(("grasp", "objects"), "no objects to grasp: give at least one")])
     checked.robots[0].config.arm(arm)  # unknown arm → NotFound before any simulation
@@ -116,11 +120,6 @@ def _print(report, timing, record, save_cloud, quiet: bool) -> None:
         for e in failed[:3]:
             out.print(f"episode {e.index} ({e.object}): {e.failed_phase}: {e.reason}", markup=False)
         return
-    from rich.table import Table
-
-    table = Table(title=f"run grasp: {report.robot} (arm {report.arm}), seed {report.seed}", show_header=False)
-    table.add_column("key")
-    table.add_column("value")
     rows = [("episodes", str(s.episodes)),
             ("lift success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%}); first attempt {s.first_attempt_rate:.1%}"),
             ("by object", ", ".join(f"{k} {v}" for k, v in s.by_object.items())),
@@ -139,9 +138,7 @@ def _print(report, timing, record, save_cloud, quiet: bool) -> None:
         rows.append(("record", str(record)))
     if save_cloud:
         rows.append(("cloud", str(save_cloud)))
-    for k, v in rows:
-        table.add_row(k, v)
-    out.print(table)
+    out.print(key_value_table(f"run grasp: {report.robot} (arm {report.arm}), seed {report.seed}", rows))
     for e in failed[:20]:
         out.print(f"[red]episode {e.index} ({e.object}, seed {e.seed}) failed[/red]: {e.failed_phase}: {e.reason}", highlight=False)
     if len(failed) > 20:

@@ -6,7 +6,16 @@ from typing import Annotated
 
 import typer
 
-from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, console, write_json
+from robocfg.cli.common import (
+    GuiOpt,
+    JsonOpt,
+    QuietOpt,
+    RecordOpt,
+    RobotOpt,
+    console,
+    load_task_for,
+    run_and_report,
+)
 
 SAMPLE_EVERY = 0.25  # s between the width samples printed
 
@@ -20,33 +29,13 @@ def gripper(
     quiet: QuietOpt = False,
 ) -> int:
     """Close then open the first arm's gripper; report measured widths, timing, mimic error and the hold test."""
-    from robocfg.checks import load_task
-    from robocfg.config import catalog
-    from robocfg.config.task import GripperTask
-    from robocfg.errors import ConfigError, RunFailed
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
     from robocfg.runners.gripper import run_gripper
 
-    checked = load_task(catalog.find("tasks", task), robot_override=robot)
-    if not isinstance(checked.config, GripperTask):
-        raise ConfigError([checked.doc.problem(("task",), f"'run gripper' needs a 'task: gripper' file, this is "
-                                                         f"'task: {checked.config.task}'")])
-    try:
-        result = run_gripper(checked, gui=gui, record=record)
-    except RunFailed as exc:
-        if exc.report is not None:
-            write_json(json_path, exc.report)
-            if not quiet:
-                _print(exc.report)
-        raise
-    write_json(json_path, result)
-    if quiet:
-        console().print(_one_line(result))
-    else:
-        _print(result)
-    return 0
+    checked = load_task_for(task, "gripper", "gripper", robot)
+    return run_and_report(lambda: run_gripper(checked, gui=gui, record=record), json_path, quiet, _print, _one_line)
 
 
 def _mm(v: float | None) -> str:

@@ -15,6 +15,8 @@ from robocfg.cli.common import (
     RobotOpt,
     SeedOpt,
     console,
+    key_value_table,
+    load_task_for,
     write_json,
 )
 
@@ -39,19 +41,12 @@ def run_pick_place(
     --json report (one record per episode; no wall-clock figures, so the same seed gives the same
     file) is written either way.
     """
-    from robocfg.checks import load_task
-    from robocfg.config import catalog
-    from robocfg.config.task import PickPlaceTask
-    from robocfg.errors import ConfigError
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
     from robocfg.runners.pick_place import run_pick_place as run
 
-    checked = load_task(catalog.find("tasks", task), robot_override=robot)
-    if not isinstance(checked.config, PickPlaceTask):
-        raise ConfigError([checked.doc.problem(("task",), f"'run pick-place' needs a 'task: pick_place' file, "
-                                                         f"this is 'task: {checked.config.task}'")])
+    checked = load_task_for(task, "pick_place", "pick-place", robot)
     checked.robots[0].config.arm(arm)  # unknown arm → NotFound before any simulation
     out = console()
     for w in checked.warnings:
@@ -102,11 +97,6 @@ def _print(report, timing, record, quiet: bool) -> None:
         out.print(f"{'ok' if not failed else 'failed'}: {report.robot} placed {s.successes}/{s.episodes} "
                   f"({s.success_rate:.1%}), {s.mean_sim_time:.2f} s simulated per episode", markup=False)
         return
-    from rich.table import Table
-
-    table = Table(title=f"run pick-place: {report.robot} (arm {report.arm}), seed {report.seed}", show_header=False)
-    table.add_column("key")
-    table.add_column("value")
     rows = [("episodes", str(s.episodes)), ("success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%})"),
             ("failures by phase", ", ".join(f"{k}: {v}" for k, v in s.failures_by_phase.items()) or "none"),
             ("simulated time / episode", f"{s.mean_sim_time:.2f} s"),
@@ -116,9 +106,7 @@ def _print(report, timing, record, quiet: bool) -> None:
         rows += [("place error", f"{e.place_error * 100:.2f} cm"), ("tilt", f"{e.tilt_deg:.1f}°")]
     if record:
         rows.append(("record", str(record)))
-    for k, v in rows:
-        table.add_row(k, v)
-    out.print(table)
+    out.print(key_value_table(f"run pick-place: {report.robot} (arm {report.arm}), seed {report.seed}", rows))
     for e in failed[:20]:
         out.print(f"[red]episode {e.index} (seed {e.seed}) failed[/red]: {e.failed_phase}: {e.reason}")
     if len(failed) > 20:

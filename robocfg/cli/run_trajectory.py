@@ -7,7 +7,16 @@ from typing import Annotated
 
 import typer
 
-from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, console, write_json
+from robocfg.cli.common import (
+    GuiOpt,
+    JsonOpt,
+    QuietOpt,
+    RecordOpt,
+    RobotOpt,
+    console,
+    load_task_for,
+    write_json,
+)
 
 PlotOpt = Annotated[Path | None, typer.Option("--plot", help="Write a PNG of q, q̇, q̈ per joint against time (limits dashed).", dir_okay=False)]
 
@@ -25,19 +34,13 @@ def run_trajectory(
     """Plan a time-optimal trajectory through the task's waypoints (toppra; trapezoids with
     stop_at_waypoints; ruckig with a jerk limit), check it against the limits at 1 kHz, and track it
     in PyBullet. Prints duration, planning time, violations and tracking error."""
-    from robocfg.checks import load_task
-    from robocfg.config import catalog
-    from robocfg.config.task import TrajectoryTask
-    from robocfg.errors import ConfigError, RunFailed
+    from robocfg.errors import RunFailed
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
     from robocfg.runners.trajectory import run_trajectory as run
 
-    checked = load_task(catalog.find("tasks", task), robot_override=robot)
-    if not isinstance(checked.config, TrajectoryTask):
-        raise ConfigError([checked.doc.problem(("task",), f"'run trajectory' needs a 'task: trajectory' file, this is "
-                                                         f"'task: {checked.config.task}'")])
+    checked = load_task_for(task, "trajectory", "trajectory", robot)
     if record is not None and no_sim:
         raise typer.BadParameter("--record needs the simulation (drop --no-sim)")
     try:
