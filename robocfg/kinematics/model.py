@@ -75,6 +75,7 @@ class KinematicModel:
     urdf_path: str = ""
     locked: dict[str, float] = field(default_factory=dict)  # locked joint → value (rad or m)
     default_backend: str = "lm"
+    robot: CheckedRobot | None = field(default=None, repr=False)  # source config (collision geometry for IK)
     _solvers: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -161,6 +162,7 @@ class KinematicModel:
             urdf_path=str(robot.urdf_path),
             locked={full.names[j]: float(q_full[full.joints[j].idx_q]) for j in lock_ids},
             default_backend=cfg.ik_backend,
+            robot=robot,
         )
 
     # ------------------------------------------------------------------ queries

@@ -2,7 +2,7 @@
 
 Backends are looked up by name in :mod:`robocfg.kinematics.ik.registry` (the robot YAML's
 ``ik_backend``): ``lm`` (Levenberg–Marquardt with random restarts), ``pink`` (differential-IK
-QP), ``placo`` (placo's kinematics solver).
+QP), ``placo`` (placo's kinematics solver, with self-collision avoidance).
 """
 
 from robocfg.kinematics.ik.registry import get_backend, known_backends, register

@@ -4,8 +4,21 @@ placo's ``RobotWrapper`` always adds a floating base: it is placed at the mount 
 as are every non-arm joint (set to the model's locked values). The TCP is added to the URDF given
 to placo as a fixed link, so its frame task acts on the same point as the other backends. Each
 ``solve(True)`` is one QP step followed by integration; steps repeat until the tolerance, a stall,
-or the time budget. Self-collision avoidance is not enabled here (collision meshes are not
-loaded): this backend answers the pure IK question like the others.
+or the time budget.
+
+Self-collision avoidance (``self_collision=True``, the default when the model knows its robot
+config): the URDF's collision geometry is added as convex hulls built from the mesh vertices
+(the reactive controller's helpers; loading the meshes through placo takes seconds). Pairs are
+every two geometries under different arm joints that are more than ``2·margin`` apart at home
+(adjacent hulls overlap there). Each descent runs without the constraint, so a collision-free
+answer costs what pure IK costs (plus one collision check, ≈ 0.04 ms for the Panda's 40 pairs).
+When its answer penetrates, a *repair* descent starts from that answer with placo's
+``AvoidSelfCollisions`` constraint (linearised ``d + J·Δq ≥ margin`` for pairs closer than
+``trigger``, hard priority; at most ``repair_iter`` steps, ≈ 0.3 ms each): it moves along the
+self-motion out of collision while the frame task holds the pose. If that fails (the branch is
+colliding), the search restarts from a random configuration. An answer is only accepted when no
+pair penetrates; if none is found in the budget the result is ``converged=False`` (best q kept,
+collision-free ones ranked first). Pairs left out (close at home) are not checked.
 
 placo is imported when the solver is built.
 """
@@ -62,18 +75,22 @@ def _urdf_with_tcp(km: KinematicModel) -> str:
 
 @register("placo")
 class PlacoSolver:
-    """placo KinematicsSolver with a frame task (or a position task) and joint limits."""
+    """placo KinematicsSolver with a frame task (or a position task), joint limits and (optionally)
+    self-collision avoidance. ``margin``/``trigger`` in metres."""
 
     name = "placo"
     clock = staticmethod(perf_counter)  # what the time budget is measured with (thread_time: CPU)
 
     def __init__(self, model: KinematicModel, tol_pos: float = 1e-5, tol_rot: float = 1e-5,
-                 max_iter: int = 100, stall_ratio: float = 0.9, stall_n: int = 5):
+                 max_iter: int = 100, stall_ratio: float = 0.9, stall_n: int = 5,
+                 self_collision: bool = True, margin: float = 0.02, trigger: float = 0.10,
+                 repair_iter: int = 20):
         import placo
 
         self.km = model
         self.tol_pos, self.tol_rot = tol_pos, tol_rot
         self.max_iter, self.stall_ratio, self.stall_n = max_iter, stall_ratio, stall_n
+        self.repair_iter = repair_iter  # QP steps of a repair descent (each ≈ 0.3 ms: distances of every pair)
         self.robot = placo.RobotWrapper(str(model.urdf_path), placo.Flags.ignore_collisions, _urdf_with_tcp(model))
         for name, value in model.locked.items():
             self.robot.set_joint(name, value)
@@ -87,6 +104,83 @@ class PlacoSolver:
         self.solver.enable_velocity_limits(False)
         self.solver.dt = 1.0
         self._task = None
+        self.field = None  # DistanceField over the self-collision pairs (None: avoidance off)
+        self.pair_names: list[tuple[str, str]] = []
+        self._avoid = None  # placo's constraint while it is in the QP
+        if self_collision and model.robot is not None:
+            self._setup_self_collision(margin, trigger)
+
+    def _setup_self_collision(self, margin: float, trigger: float) -> None:
+        """Add the robot's collision hulls (and the other arms', locked) and select the self pairs."""
+        import pinocchio as pin
+
+        from robocfg.motion.reactive.collision import add_robot_geometry, robot_geometry_ids
+        from robocfg.motion.reactive.distances import DistanceField
+        from robocfg.motion.reactive.setup import robot_geometry
+
+        geoms, _missing = robot_geometry(self.km.robot)  # links with unreadable meshes are not avoided
+        g = self.robot.collision_model
+        add_robot_geometry(g, self.robot.model, geoms)
+        model = self.robot.model
+        arm_ids = {model.getJointId(n) for n in self.km.joint_names}
+        anc = []  # nearest arm joint at or above each joint: geometry under the same one is rigid
+        for j in range(model.njoints):
+            while j > 0 and j not in arm_ids:
+                j = model.parents[j]
+            anc.append(j)
+        ids = robot_geometry_ids(g, set())
+        g.removeAllCollisionPairs()
+        for i, a in enumerate(ids):
+            for b in ids[i + 1:]:
+                if anc[g.geometryObjects[a].parentJoint] != anc[g.geometryObjects[b].parentJoint]:
+                    g.addCollisionPair(pin.CollisionPair(a, b))
+        self._set_q(self.km.home)
+        field = DistanceField(model, g)
+        field.update(np.asarray(self.robot.state.q))
+        _, dist = field.query(0.0)
+        keep = [(p.first, p.second) for p, d in zip(g.collisionPairs, dist, strict=True) if d > 2 * margin]
+        g.removeAllCollisionPairs()
+        for a, b in keep:
+            g.addCollisionPair(pin.CollisionPair(a, b))
+        if not keep:
+            return
+        self.pair_names = [(g.geometryObjects[a].name, g.geometryObjects[b].name) for a, b in keep]
+        self.field = DistanceField(model, g)
+        self.margin, self.trigger = margin, trigger
+
+    def _set_avoid(self, on: bool) -> None:
+        """Add or remove placo's self-collision constraint (placo frees a removed constraint, so it is
+        created anew each time)."""
+        if self.field is None or on == (self._avoid is not None):
+            return
+        if on:
+            self._avoid = self.solver.add_avoid_self_collisions_constraint()
+            self._avoid.configure("self_collisions", "hard", 1.0)
+            self._avoid.self_collisions_margin = self.margin
+            self._avoid.self_collisions_trigger = self.trigger
+        else:
+            self.solver.remove_constraint(self._avoid)
+            self._avoid = None
+
+    def min_distance(self, q: np.ndarray) -> float:
+        """Smallest distance (m, negative: penetration) over the self-collision pairs at arm
+        values ``q`` (inf when avoidance is off)."""
+        if self.field is None:
+            return math.inf
+        self._set_q(q)
+        self.field.update(np.asarray(self.robot.state.q))
+        _, dist = self.field.query(0.0)
+        return float(dist.min()) if len(dist) else math.inf
+
+    def collides(self, q: np.ndarray) -> bool:
+        """True if some self-collision pair penetrates at arm values ``q`` (False when avoidance is off)."""
+        import pinocchio as pin
+
+        if self.field is None:
+            return False
+        self._set_q(q)
+        f = self.field
+        return bool(pin.computeCollisions(f.model, f.data, f.geom, f.gdata, np.asarray(self.robot.state.q), True))
 
     def _frame(self, frame: str) -> str:
         return PLACO_TCP if frame == "tcp" else self.km.frame_name(frame)
@@ -112,11 +206,27 @@ class PlacoSolver:
         self._task.configure("target", "soft", 1.0)
 
         def descend(q: np.ndarray, deadline: float):
-            return self._descend(q, Mt, fid, position_only, deadline)
+            self._set_avoid(False)
+            ok, it, s, q_end = self._descend(q, Mt, fid, position_only, deadline)
+            if not ok or self.field is None or not self.collides(q_end):
+                return ok, it, s, q_end
+            # the answer penetrates: from it, move along the self-motion out of collision, keeping the pose
+            ok2, it2 = False, 0
+            if self.repair_iter > 0:
+                self._set_avoid(True)
+                ok2, it2, s2, q2 = self._descend(q_end, Mt, fid, position_only, deadline, self.repair_iter)
+            if ok2:
+                return ok2, it + it2, s2, q2
+            return False, it + it2, s + 1.0, q_end  # penalised: any collision-free q ranks first
 
+        self._set_avoid(False)
         best_q, iters, restarts = search(km, descend, q0, self.clock() + time_budget, rng, self.clock)
-        return finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only, self.tol_pos, self.tol_rot,
-                      t0, iters, restarts)
+        self._set_avoid(False)
+        res = finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only, self.tol_pos, self.tol_rot,
+                     t0, iters, restarts)
+        if res.converged and self.collides(res.q):
+            res.converged = False
+        return res
 
     def _set_q(self, q: np.ndarray) -> None:
         for name, v in zip(self.km.joint_names, q.tolist(), strict=True):
@@ -126,29 +236,32 @@ class PlacoSolver:
     def _get_q(self) -> np.ndarray:
         return np.array([self.robot.get_joint(n) for n in self.km.joint_names])
 
-    def _descend(self, q, Mt, fid, position_only, deadline):
+    def _descend(self, q, Mt, fid, position_only, deadline, max_iter=None):
         import pinocchio as pin
 
         km = self.km
         self._set_q(q)
         best_s, best_q, ref_s, stall = math.inf, q, math.inf, 0
-        for it in range(1, self.max_iter + 1):
+        max_iter = max_iter or self.max_iter
+        for it in range(1, max_iter + 1):
             qc = km.lower + np.clip(self._get_q() - km.lower, 0.0, km.upper - km.lower)
             pin.forwardKinematics(km.model, km.data, qc)
             d = pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)
             pe = float(np.linalg.norm(d.translation))
             re = 0.0 if position_only else float(np.linalg.norm(pin.log3(d.rotation)))
             s = pe + re
-            if s < best_s:
-                best_s, best_q = s, qc
-            if pe <= self.tol_pos and re <= self.tol_rot:
-                return True, it, s, qc
-            if s < ref_s * self.stall_ratio:
-                ref_s, stall = s, 0
-            else:
-                stall += 1
-                if stall >= self.stall_n:
-                    return False, it, best_s, best_q
+            # with the constraint on, penetrating configurations are neither answers nor stalls
+            if self._avoid is None or not self.collides(qc):
+                if s < best_s:
+                    best_s, best_q = s, qc
+                if pe <= self.tol_pos and re <= self.tol_rot:
+                    return True, it, s, qc
+                if s < ref_s * self.stall_ratio:
+                    ref_s, stall = s, 0
+                else:
+                    stall += 1
+                    if stall >= self.stall_n:
+                        return False, it, best_s, best_q
             if self.clock() >= deadline:
                 return False, it, best_s, best_q
             try:
@@ -156,4 +269,4 @@ class PlacoSolver:
             except RuntimeError:  # placo raises RuntimeError when its QP is infeasible
                 return False, it, best_s, best_q
             self.robot.update_kinematics()
-        return False, self.max_iter, best_s, best_q
+        return False, max_iter, best_s, best_q
