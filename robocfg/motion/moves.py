@@ -4,7 +4,8 @@ min-jerk timing, trajectory following, convergence checks, and close-until-held.
 Used by pick-place and grasp: ``ArmMover.move(T_goal, straight=...)`` plans IK waypoints every
 ``CARTESIAN_STEP`` m along a straight EE line (or, for a joint-space move, the IK answer nearest
 the current joints), times them with ``MinJerkPath``, sends position + velocity targets every
-physics step, and waits until the EE is within tolerance. Failures raise
+physics step, and waits until the EE is within tolerance (``move_reactive`` instead steps a
+follow-target controller that avoids the scene, with the same checks). Failures raise
 ``MoveFailed(phase, reason)``. Poses are world_T_ee (4x4, m).
 
 IK is bounded by an iteration budget (``bound_ik_by_iterations``) rather than wall-clock time, so
@@ -113,6 +114,31 @@ class ArmMover:
             t_start = self.world.t
             self.play(traj)
             self.converge(T_goal, t_start)
+        if check is not None:
+            reason = check()
+            if reason:
+                raise MoveFailed(self.phase, reason)
+
+    def move_reactive(self, T_goal: np.ndarray, drive, check: Callable[[], str | None] | None = None) -> None:
+        """Go to ``T_goal`` driven by the follow-target controller of ``drive`` (a
+        :class:`~robocfg.motion.reactive_drive.ReactiveDrive`), which keeps the arm clear of the
+        scene; same convergence tolerances, ``timeout`` and ``check()`` as :meth:`move`."""
+        ctrl, T_tcp = drive.controller, T_goal @ drive.T_ee_tcp
+        ctrl.reset(self.arm.joint_positions())
+        t_start, still = self.world.t, np.zeros(6)
+        while True:
+            T = self.arm.ee_pose()
+            dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
+            dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
+            if dp <= self.position_tolerance and dr <= self.orientation_tolerance:
+                break
+            if self.world.t - t_start > self.timeout:
+                raise MoveFailed(self.phase, f"did not converge within {self.timeout:.1f} s "
+                                             f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
+            res = ctrl.step(T_tcp, q_measured=self.arm.joint_positions(), velocity=still)
+            self.arm.command(res.q, res.dq)
+            self.step(drive.substeps)
+        self.arm.command(ctrl.q, np.zeros_like(ctrl.q))  # hold where the controller stopped
         if check is not None:
             reason = check()
             if reason:

@@ -4,7 +4,10 @@ Every target comes from the robot YAML through one conversion (design.md §3): a
 GraspNet grasp (approach straight down, fingers closing across the object's narrower horizontal
 side) → ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``) → IK (continuous
 along straight TCP lines) → min-jerk timed joint trajectories → position drives, all through
-:class:`robocfg.motion.moves.ArmMover`. The object is held by friction only (parallel grippers)
+:class:`robocfg.motion.moves.ArmMover`. With ``motion: reactive`` the two free-space moves
+(pre-grasp, transport) are driven by the follow-target controller instead
+(:mod:`robocfg.motion.reactive_drive`, built once per run), which keeps the arm and the held
+object clear of the scene's obstacles. The object is held by friction only (parallel grippers)
 or by the suction cup.
 """
 
@@ -101,6 +104,7 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
             model,
             limits_from_robot(robot, handle.joints, Limits(velocity_scale=params.speed_scale,
                                                            acceleration_scale=params.speed_scale)),
+            _reactive_drive(robot, world, arm_cfg.name, params),
         )
         for setup in episode_setups(params, seed, episodes):
             t0, physics0 = time.perf_counter(), world.physics_seconds
@@ -125,16 +129,36 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
                 on_episode(res)
     timing.wall_time = time.perf_counter() - t_all
     report = PickPlaceReport(task=str(task.path), robot=robot.config.name, arm=arm_cfg.name, seed=seed,
-                             summary=summarise(results), episodes=results, warnings=[w.format() for w in task.warnings])
+                             summary=summarise(results), episodes=results,
+                             warnings=[w.format() for w in task.warnings] + _reactive_warnings(tools.reactive))
     return report, timing
+
+
+def _reactive_warnings(drive) -> list[str]:
+    return [f"obstacle {name!r} is a mesh: the reactive controller does not avoid it"
+            for name in (drive.skipped if drive is not None else [])]
 
 
 @dataclass(frozen=True)
 class _Tools:
-    """Per-run helpers shared by every episode: kinematic model and scaled joint limits."""
+    """Per-run helpers shared by every episode: kinematic model, scaled joint limits and, with
+    ``motion: reactive``, the follow-target controller driving the free-space moves."""
 
     model: object
     limits: object
+    reactive: object | None = None
+
+
+def _reactive_drive(robot, world, arm_name: str, params: PickPlaceParams):
+    """The controller for ``motion: reactive`` (built once per run: it is expensive), else None."""
+    if params.motion != "reactive":
+        return None
+    from robocfg.motion.reactive_drive import bounding_radius, build_reactive_drive
+
+    obj = params.object  # held object's centre beyond the TCP, along the tool axis (m)
+    beyond = obj.half_height() - SUCTION_PRESS if world.robot.arm(arm_name).gripper.grasps_at_surface else params.grasp_depth
+    return build_reactive_drive(robot, world, arm_name, velocity_scale=params.speed_scale,
+                                payload=(beyond, bounding_radius(obj)))
 
 
 class _StateMachine:
@@ -144,6 +168,7 @@ class _StateMachine:
         self.log = log or (lambda _msg: None)
         self.arm, self.cfg, self.gripper = arm, arm.config, arm.gripper
         self.model = tools.model
+        self.reactive = tools.reactive
         self.mover = ArmMover(world, arm, tools.model, tools.limits, params.position_tolerance,
                               params.orientation_tolerance, on_step=self._on_step, phase="setup")
         if params.grip_force is not None and hasattr(self.gripper, "set_force"):
@@ -169,7 +194,7 @@ class _StateMachine:
         T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
 
         self.begin("pre_grasp", "move above the object")
-        self.mover.move(T_pre, straight=False)
+        self._free_move(T_pre)
         self.begin("approach", "down to grasp height")
         self.mover.move(T_grasp, straight=True)
         self.begin("grasp", "close the gripper")
@@ -190,7 +215,7 @@ class _StateMachine:
         T_above_place = T_place.copy()
         T_above_place[2, 3] = max(T_lift[2, 3], T_place[2, 3] + p.lift_height)
         self.begin("transport", "carry above the place point")
-        self.mover.move(T_above_place, straight=False, check=self._dropped)
+        self._free_move(T_above_place, check=self._dropped)
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
         self.begin("release", "open the gripper")
@@ -217,6 +242,13 @@ class _StateMachine:
         self._phase = None
 
     # ---- motion ------------------------------------------------------------------------------
+    def _free_move(self, T: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
+        """A free-space move (pre-grasp, transport): joint-space trajectory or reactive controller."""
+        if self.reactive is None:
+            self.mover.move(T, straight=False, check=check)
+        else:
+            self.mover.move_reactive(T, self.reactive, check=check)
+
     def _choose_grasp(self, center: np.ndarray) -> Grasp:
         """Of the two top-down grasps, the one needing the least joint travel (largest |Δq|, rad)
         to reach the pre-grasp pose and from there the pose above the place point; the smaller
