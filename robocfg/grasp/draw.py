@@ -9,7 +9,6 @@ green, the others orange.
 from __future__ import annotations
 
 import numpy as np
-import pybullet as p
 
 from robocfg.sim.record import Recorder
 
@@ -66,12 +65,5 @@ class GraspRecorder(Recorder):
 
     def _matrix(self) -> np.ndarray:
         """projection · view of the recorder's camera (row-major 4x4), as in ``Recorder.render``."""
-        w, h = self.size
-        cam, c = self.camera, self.world.client
-        if cam.eye is not None:
-            view = p.computeViewMatrix(list(cam.eye), list(cam.target), [0, 0, 1], physicsClientId=c)
-        else:
-            view = p.computeViewMatrixFromYawPitchRoll(list(cam.target), cam.distance, cam.yaw_deg, cam.pitch_deg,
-                                                       0.0, 2, physicsClientId=c)
-        proj = p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.02, 20.0, physicsClientId=c)
+        view, proj = self.view_projection()
         return np.asarray(proj, float).reshape(4, 4).T @ np.asarray(view, float).reshape(4, 4).T

@@ -50,8 +50,8 @@ class Recorder:
             raise RobocfgError(f"--record needs a .gif or .png file name, got {self.path.name!r}")
         self.animate = self.path.suffix.lower() == ".gif"
 
-    def render(self) -> np.ndarray:
-        """One RGB frame (H, W, 3) uint8 from the current state."""
+    def view_projection(self) -> tuple[list[float], list[float]]:
+        """PyBullet's (view, projection) matrices of the camera (column-major 16-lists)."""
         w, h = self.size
         cam, c = self.camera, self.world.client
         if cam.eye is not None:
@@ -60,6 +60,13 @@ class Recorder:
             view = p.computeViewMatrixFromYawPitchRoll(list(cam.target), cam.distance, cam.yaw_deg, cam.pitch_deg,
                                                        0.0, 2, physicsClientId=c)
         proj = p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.02, 20.0, physicsClientId=c)
+        return view, proj
+
+    def render(self) -> np.ndarray:
+        """One RGB frame (H, W, 3) uint8 from the current state."""
+        w, h = self.size
+        cam, c = self.camera, self.world.client
+        view, proj = self.view_projection()
         img = p.getCameraImage(w, h, view, proj, renderer=p.ER_TINY_RENDERER, shadow=int(cam.shadow),
                                lightDirection=list(cam.light_direction), physicsClientId=c)
         rgba = np.reshape(np.asarray(img[2], dtype=np.uint8), (h, w, 4))
