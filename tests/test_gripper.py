@@ -151,3 +151,17 @@ def test_suction_lets_go_above_hold_force(tmp_path):
         _lift_to(w, 0.25)
         assert g.released_by_load and not g.is_grasping("box")
         assert w.body_pose("box")[0][2] < 0.03
+
+
+
+def test_state_reads_closed_while_holding_an_object():
+    """A gripper closed on the task's 4 cm cube reads closed (−1.0), not open, whatever its gap."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.runners.gripper import run_gripper
+
+    result = run_gripper(load_task(catalog.find("tasks", "gripper")))
+    grasp = [m for m in result.moves if m.phase == "grasp"]
+    assert grasp and result.hold is not None and result.hold.held
+    assert grasp[0].width_end > 0.02 and grasp[0].state_end == -1.0
+    assert [m.state_end for m in result.moves if m.phase == "open"] == [1.0]

@@ -3,26 +3,13 @@
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-
-from robocfg.cli.app import main
+from _cli import run_main
 
 ROOT = Path(__file__).parents[1]
-
-
-def run_main(args: list[str], capsys, monkeypatch) -> tuple[int, str, str]:
-    monkeypatch.chdir(ROOT)
-    monkeypatch.delenv("ROBOCFG_DEBUG", raising=False)
-    monkeypatch.setattr(sys, "argv", ["robocfg", *args])
-    with pytest.raises(SystemExit) as exc:
-        main()
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
 
 
 def test_ik_converges_and_fk_matches(tmp_path, capsys, monkeypatch) -> None:

@@ -2,34 +2,22 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pybullet_data
 import pytest
 import yaml
+from _cli import run_main
 
 from robocfg.assets.draft import draft_robot, render_yaml
 from robocfg.assets.urdf import parse_urdf
 from robocfg.checks import load_robot
-from robocfg.cli.app import main
 
 ROOT = Path(__file__).resolve().parent.parent
 PANDA_URDF = Path(pybullet_data.getDataPath()) / "franka_panda" / "panda.urdf"
 IIWA_URDF = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
 KR210_URDF = ROOT / "robocfg" / "data" / "robots" / "kuka_kr210" / "kuka_kr210.urdf"
-
-
-def run_main(args: list[str], capsys, monkeypatch, cwd: Path) -> tuple[int, str, str]:
-    monkeypatch.chdir(cwd)
-    monkeypatch.delenv("ROBOCFG_DEBUG", raising=False)
-    monkeypatch.setattr(sys, "argv", ["robocfg", *args])
-    with pytest.raises(SystemExit) as exc:
-        main()
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
 
 
 def test_panda_draft_matches_the_shipped_yaml(tmp_path, capsys, monkeypatch):

@@ -3,26 +3,14 @@
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-
-from robocfg.cli.app import main
+from _cli import run_main
 
 ROOT = Path(__file__).resolve().parent.parent
 HEADER = "schema_version: 1\ntask: trajectory\nrobots:\n  - robot: panda\ntrajectory:\n"
-
-
-def run_main(args: list[str], capsys, monkeypatch) -> tuple[int, str, str]:
-    monkeypatch.chdir(ROOT)
-    monkeypatch.delenv("ROBOCFG_DEBUG", raising=False)
-    monkeypatch.setattr(sys, "argv", ["robocfg", *args])
-    with pytest.raises(SystemExit) as exc:
-        main()
-    out, err = capsys.readouterr()
-    return int(exc.value.code or 0), out, err
 
 
 def task_file(tmp_path: Path, body: str, name: str = "t.yaml") -> Path:
@@ -95,8 +83,8 @@ def test_zero_velocity_override_in_robot_yaml_is_a_config_error(tmp_path, capsys
 def test_cartesian_waypoints_use_ik_with_continuity(tmp_path):
     from robocfg.checks import load_task
     from robocfg.kinematics.model import KinematicModel
-    from robocfg.motion.waypoints import pose_matrix
     from robocfg.runners.trajectory import plan_task
+    from robocfg.sim.frames import pose_matrix
 
     poses = ["{position: [0.5, 0.1, 0.3], euler_deg: [180, 0, 0]}",
              "{position: [0.45, -0.1, 0.3], euler_deg: [180, 0, 30]}"]

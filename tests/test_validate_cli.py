@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from _cli import run_main
 
 from robocfg.cli.app import main
 
@@ -28,18 +29,6 @@ LOC_LINE = re.compile(r"^[^:]+:\d+(:\d+)?: ")
 def expectations(path: Path) -> list[str]:
     text = path.read_bytes().decode("utf-8", errors="replace")
     return [ln[len("# expect: "):].strip() for ln in text.splitlines() if ln.startswith("# expect: ")]
-
-
-def run_main(args: list[str], capsys, monkeypatch) -> tuple[int, str, str]:
-    """Run the console-script entry point in-process (its own error mapping included)."""
-    monkeypatch.chdir(ROOT)
-    monkeypatch.delenv("ROBOCFG_DEBUG", raising=False)
-    monkeypatch.setattr(sys, "argv", ["robocfg", *args])
-    with pytest.raises(SystemExit) as exc:
-        main()
-    out, err = capsys.readouterr()
-    code = exc.value.code
-    return (code if isinstance(code, int) else (0 if code is None else 1)), out, err
 
 
 def run_process(args: list[str], **kw) -> subprocess.CompletedProcess:

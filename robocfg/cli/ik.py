@@ -28,7 +28,6 @@ def _parse_floats(text: str | None, what: str) -> list[float] | None:
 def _target(position: tuple[float, float, float], euler_deg: tuple[float, float, float] | None,
             quat_xyzw: tuple[float, float, float, float] | None):
     """4x4 target from the options, validated by the same Pose model the YAML files use."""
-    import numpy as np
     from pydantic import ValidationError
 
     from robocfg.config.types import Pose
@@ -40,13 +39,9 @@ def _target(position: tuple[float, float, float], euler_deg: tuple[float, float,
     except ValidationError as exc:
         raise ConfigError([Problem("<command line>", None, None, ".".join(str(x) for x in e["loc"]) or "pose",
                                    e["msg"]) for e in exc.errors()]) from None
-    x, y, z, w = pose.quaternion_xyzw()
-    T = np.eye(4)
-    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    T[:3, 3] = pose.position
-    return T
+    from robocfg.sim.frames import pose_matrix
+
+    return pose_matrix(pose)
 
 
 def ik(

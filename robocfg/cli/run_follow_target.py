@@ -14,6 +14,7 @@ from robocfg.cli.common import (
     RecordOpt,
     RobotOpt,
     console,
+    key_value_table,
     load_task_for,
     run_and_report,
 )
@@ -59,15 +60,10 @@ def _one_line(r) -> str:
 
 
 def _print(r) -> None:
-    from rich.table import Table
 
     out = console()
     for w in r.warnings:
         out.print(f"[yellow]warning:[/yellow] {w}", markup=True)
-    t = Table(title=f"run follow-target: {r.robot} ({r.motion} target, {r.orientation} orientation"
-                    f"{', with obstacle' if r.with_obstacle else ''})", show_header=False)
-    t.add_column("key")
-    t.add_column("value")
     e, o = r.position_error_mm, r.orientation_error_deg
 
     def stats(s, u: str, d: int) -> str:
@@ -96,9 +92,8 @@ def _print(r) -> None:
         rows.append(("plot", r.plot))
     if r.record:
         rows.append(("record", r.record))
-    for k, v in rows:
-        t.add_row(k, v)
-    out.print(t)
+    out.print(key_value_table(f"run follow-target: {r.robot} ({r.motion} target, {r.orientation} orientation"
+                    f"{', with obstacle' if r.with_obstacle else ''})", rows))
     status = ("[green]ok[/green]" if r.reached else "[yellow]target not reached[/yellow]") if r.success \
         else f"[red]failed[/red]: {r.failed_phase}: {r.reason}"
     out.print(status)

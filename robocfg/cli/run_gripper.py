@@ -13,6 +13,7 @@ from robocfg.cli.common import (
     RecordOpt,
     RobotOpt,
     console,
+    key_value_table,
     load_task_for,
     run_and_report,
 )
@@ -61,9 +62,6 @@ def _print(r) -> None:
     out = console()
     for w in r.warnings:
         out.print(f"[yellow]warning:[/yellow] {w}", markup=True)
-    head = Table(title=f"run gripper: {r.robot} ({r.gripper_type}, {r.mode})", show_header=False)
-    head.add_column("key")
-    head.add_column("value")
     rows = [
         ("time to close", _s(r.time_to_close)), ("time to open", _s(r.time_to_open)),
         ("final closed width", _mm(r.final_closed_width)), ("final open width", _mm(r.final_open_width)),
@@ -80,9 +78,7 @@ def _print(r) -> None:
     rows += [("simulated / wall time", f"{r.sim_time:.2f} s / {r.wall_time:.2f} s")]
     if r.record:
         rows.append(("record", r.record))
-    for k, v in rows:
-        head.add_row(k, v)
-    out.print(head)
+    out.print(key_value_table(f"run gripper: {r.robot} ({r.gripper_type}, {r.mode})", rows))
     moves = Table(title="moves")
     for col in ("phase", "cycle", "t start", "width start", "width end", "settled after", "state", "mimic err"):
         moves.add_column(col)

@@ -14,6 +14,7 @@ from robocfg.cli.common import (
     RecordOpt,
     RobotOpt,
     console,
+    key_value_table,
     load_task_for,
     write_json,
 )
@@ -91,9 +92,6 @@ def _print(r) -> None:
         out.print(f"[yellow]warning:[/yellow] {escape(w)}", markup=True)
     for n in r.notes:
         out.print(f"note: {n}", markup=False)
-    head = Table(title=f"run trajectory: {r.robot} ({r.arm})", show_header=False)
-    head.add_column("key")
-    head.add_column("value")
     lc = r.limit_check
     rows = [
         ("method", f"{r.method} ({r.path} path" + (f", {r.gridpoints} gridpoints" if r.gridpoints else "") + ")"),
@@ -112,9 +110,7 @@ def _print(r) -> None:
         rows.append(("plot", r.plot))
     if r.record:
         rows.append(("record", r.record))
-    for k, v in rows:
-        head.add_row(k, v)
-    out.print(head)
+    out.print(key_value_table(f"run trajectory: {r.robot} ({r.arm})", rows))
     wp = Table(title="waypoints")
     for col in ("#", "from", "t (s)", *r.joint_names):
         wp.add_column(col)

@@ -39,8 +39,9 @@ class ParallelGripperConfig(Frozen):
     max_force: PositiveFloat = Field(40.0, description="Force (N) or torque (N·m) per driven joint.")
     max_velocity: PositiveFloat | None = Field(None, description="Joint speed cap while moving (rad/s or m/s).")
     state_threshold: Annotated[float, Field(gt=0, lt=1)] = Field(
-        0.5,
-        description="Fraction of the closed→open travel above which the state is open (1.0), else closed (-1.0).",
+        0.9,
+        description="Fraction of the closed→open travel above which the state is open (1.0), else closed (-1.0); "
+        "0.9 makes any grasp read as closed, as seed 004's 'open only when (nearly) fully open'.",
     )
     lateral_friction: PositiveFloat = Field(1.0, description="Friction coefficient given to the finger links.")
 

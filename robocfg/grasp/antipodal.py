@@ -32,8 +32,8 @@ from robocfg.kinematics.frames import Grasp, rotation_angle
 REASONS = ("not_antipodal", "too_wide", "collision", "slips_at_contact", "linkage_collision", "unreachable")
 APPROACH_ANGLES_DEG = (0.0, 30.0, -30.0, 60.0, -60.0)
 LEVEL_TILT = 0.05  # closing axes steeper than this (sine) also get a level variant
-MIN_CONTACT_POINTS = 4
-LINKAGE_MARGIN = 0.001  # m: clearance kept between closing knuckles/linkages and the cloud  # cloud points a finger must find at its contact (a patch, not an edge)
+MIN_CONTACT_POINTS = 4  # cloud points a finger must find at its contact (a patch, not an edge)
+LINKAGE_MARGIN = 0.001  # m: clearance kept between closing knuckles/linkages and the cloud
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ from robocfg.config.suggest import did_you_mean
 from robocfg.config.types import Pose
 from robocfg.errors import ConfigError, Problem, RunFailed
 from robocfg.motion.limits import JointLimits
+from robocfg.sim.frames import pose_matrix
 
 LIMIT_TOL = 1e-9
 IK_POS_TOL = 1e-3  # m
@@ -45,13 +46,6 @@ class Waypoints:
     kinds: list[str]
     ik_errors: dict[int, tuple[float, float]]  # waypoint → (position m, rotation rad) residual
     warnings: list[str]
-
-
-def pose_matrix(pose: Pose) -> np.ndarray:
-    """world_T_tcp (4x4) of a task Pose."""
-    from robocfg.sim.frames import pose_to_matrix
-
-    return pose_to_matrix(pose.position, pose.quaternion_xyzw())
 
 
 def resolve_waypoints(items: list, limits: JointLimits, home: np.ndarray, problem: ProblemFn,

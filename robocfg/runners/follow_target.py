@@ -24,6 +24,7 @@ from robocfg.config.commands import FollowObstacle, FollowTargetParams
 from robocfg.config.scene import Body
 from robocfg.config.types import euler_deg_to_quat_xyzw
 from robocfg.errors import RunFailed
+from robocfg.kinematics.frames import rotation_angle
 
 CLEARANCE_QUERY = 0.5  # m: clearances beyond this are reported as this value
 SAMPLE_RATE = 60.0  # Hz of the samples kept in the result
@@ -97,16 +98,10 @@ class FollowTargetResult:
         return asdict(self)
 
 
-def _rot_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
-    c = (np.trace(Ra.T @ Rb) - 1.0) / 2.0
-    return float(math.acos(min(1.0, max(-1.0, c))))
-
-
 def _euler_matrix(rpy_deg) -> np.ndarray:
-    x, y, z, w = euler_deg_to_quat_xyzw(rpy_deg)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    from robocfg.sim.frames import quat_to_matrix
+
+    return quat_to_matrix(euler_deg_to_quat_xyzw(rpy_deg))
 
 
 def _obstacles(params: FollowTargetParams, with_obstacle: bool, start: np.ndarray, goal: np.ndarray) -> list[FollowObstacle]:
@@ -159,8 +154,9 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
     import pybullet
 
     from robocfg.motion.reactive import EscapeSettings, ReactiveController, ReactiveSettings
-    from robocfg.motion.reactive.setup import arm_spec, body_shape, pose_matrix, scene_shapes
+    from robocfg.motion.reactive.setup import arm_spec, body_shape, scene_shapes
     from robocfg.motion.targets import TargetMotion
+    from robocfg.sim.frames import pose_matrix
     from robocfg.sim.loading import prepared_urdf
     from robocfg.sim.record import CameraView, Recorder
     from robocfg.sim.world import World
@@ -255,7 +251,7 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
                 world.set_body_pose(marker, T_goal[:3, 3])
                 tcp = arm.tcp_pose()
                 e_pos = float(np.linalg.norm(tcp[:3, 3] - T_goal[:3, 3]))
-                e_rot = _rot_angle(tcp[:3, :3], T_goal[:3, :3])
+                e_rot = rotation_angle(tcp[:3, :3], T_goal[:3, :3])
                 clearance = math.inf
                 if obstacle_ids:
                     clearance, link, obst = probe.clearance()

@@ -1,4 +1,5 @@
-"""Small pose helpers: (position, quat_xyzw) ↔ 4x4 homogeneous matrices. Units: m."""
+"""Small pose helpers: (position, quat_xyzw) ↔ 4x4 homogeneous matrices. Units: m. numpy only
+(no pybullet), so kinematics, motion and the CLI may use it."""
 
 from __future__ import annotations
 
@@ -45,6 +46,11 @@ def pose_to_matrix(position: Sequence[float], quat_xyzw: Sequence[float]) -> np.
     T[:3, :3] = quat_to_matrix(quat_xyzw)
     T[:3, 3] = position
     return T
+
+
+def pose_matrix(pose) -> np.ndarray:
+    """4x4 world transform of a config :class:`robocfg.config.types.Pose` (position + any orientation key)."""
+    return pose_to_matrix(pose.position, pose.quaternion_xyzw())
 
 
 def matrix_to_pose(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -49,6 +49,13 @@ def check_seed(model: KinematicModel, seed_q: np.ndarray) -> np.ndarray:
     return into_limits(model, q)
 
 
+def prepare(model: KinematicModel, target: np.ndarray, seed_q: np.ndarray, frame: str):
+    """The checked inputs every backend starts from: (T target 4x4, q0 seed, frame id, target SE3)."""
+    T = check_target(target)
+    q0 = check_seed(model, seed_q)
+    return T, q0, model.frame_id(frame), pin.SE3(T[:3, :3], T[:3, 3])
+
+
 def into_limits(model: KinematicModel, q: np.ndarray) -> np.ndarray:
     """``q`` within the limits: wrapped joints (≥ 2π wide) outside their range are shifted by
     multiples of 2π (values already inside are kept), the others are clamped."""

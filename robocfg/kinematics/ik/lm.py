@@ -26,10 +26,9 @@ from scipy.linalg.lapack import dposv
 
 from robocfg.kinematics.ik.common import (
     TWO_PI,
-    check_seed,
-    check_target,
     finish,
     nearest_equivalent,
+    prepare,
 )
 from robocfg.kinematics.ik.registry import register
 
@@ -67,11 +66,9 @@ class LMSolver:
               time_budget: float = 0.02, position_only: bool = False,
               rng: np.random.Generator | None = None) -> IKResult:
         t0 = perf_counter()
-        T = check_target(target)
         km = self.km
-        q0 = q = check_seed(km, seed_q)
-        fid = km.frame_id(frame)
-        Mt = pin.SE3(T[:3, :3], T[:3, 3])
+        _, q0, fid, Mt = prepare(km, target, seed_q, frame)
+        q = q0
         deadline = self.clock() + time_budget
         best_s, best_q = math.inf, q
         iters = restarts = 0

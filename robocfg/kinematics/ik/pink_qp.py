@@ -18,10 +18,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robocfg.kinematics.ik.common import (
-    check_seed,
-    check_target,
     finish,
     nearest_equivalent,
+    prepare,
     search,
 )
 from robocfg.kinematics.ik.registry import register
@@ -53,15 +52,11 @@ class PinkSolver:
     def solve(self, target: np.ndarray, seed_q: np.ndarray, frame: str = "tcp",
               time_budget: float = 0.02, position_only: bool = False,
               rng: np.random.Generator | None = None) -> IKResult:
-        import pinocchio as pin
         from pink.tasks import FrameTask, PostureTask
 
         t0 = perf_counter()
-        T = check_target(target)
         km = self.km
-        q0 = check_seed(km, seed_q)
-        fid = km.frame_id(frame)
-        Mt = pin.SE3(T[:3, :3], T[:3, 3])
+        _, q0, fid, Mt = prepare(km, target, seed_q, frame)
         task = FrameTask(km.frame_name(frame), position_cost=1.0, orientation_cost=0.0 if position_only else 1.0)
         task.set_target(Mt)
         posture = PostureTask(cost=self.posture_cost)

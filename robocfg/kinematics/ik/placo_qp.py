@@ -33,10 +33,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robocfg.kinematics.ik.common import (
-    check_seed,
-    check_target,
     finish,
     nearest_equivalent,
+    prepare,
     search,
 )
 from robocfg.kinematics.ik.registry import register
@@ -188,14 +187,10 @@ class PlacoSolver:
     def solve(self, target: np.ndarray, seed_q: np.ndarray, frame: str = "tcp",
               time_budget: float = 0.02, position_only: bool = False,
               rng: np.random.Generator | None = None) -> IKResult:
-        import pinocchio as pin
 
         t0 = perf_counter()
-        T = check_target(target)
         km = self.km
-        q0 = check_seed(km, seed_q)
-        fid = km.frame_id(frame)
-        Mt = pin.SE3(T[:3, :3], T[:3, 3])
+        T, q0, fid, Mt = prepare(km, target, seed_q, frame)
         if self._task is not None:
             self.solver.remove_task(self._task)
         name = self._frame(frame)

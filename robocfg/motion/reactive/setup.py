@@ -11,23 +11,13 @@ import numpy as np
 
 from robocfg.config.commands import FollowObstacle
 from robocfg.config.scene import Body, Scene
-from robocfg.config.types import AXIS_INDEX, Pose
+from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import RobocfgError
 from robocfg.motion.reactive.collision import EnvShape, LinkGeometry
 from robocfg.motion.reactive.controller import ArmSpec
+from robocfg.sim.frames import pose_matrix
 
 DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
-
-
-def pose_matrix(pose: Pose) -> np.ndarray:
-    """4×4 world transform of a config ``Pose``."""
-    x, y, z, w = pose.quaternion_xyzw()
-    T = np.eye(4)
-    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    T[:3, 3] = pose.position
-    return T
 
 
 def arm_spec(robot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = None,
