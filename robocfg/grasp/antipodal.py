@@ -34,6 +34,7 @@ APPROACH_ANGLES_DEG = (0.0, 30.0, -30.0, 60.0, -60.0)
 LEVEL_TILT = 0.05  # closing axes steeper than this (sine) also get a level variant
 MIN_CONTACT_POINTS = 4  # cloud points a finger must find at its contact (a patch, not an edge)
 LINKAGE_MARGIN = 0.001  # m: clearance kept between closing knuckles/linkages and the cloud
+MIN_FACING = 0.25  # a finger pad pushes only on points whose normal faces it by more than this (cosine)
 
 
 @dataclass(frozen=True)
@@ -304,8 +305,13 @@ def _closing_check(centers, rots, P, N, curv, boxes: GripperBoxes, w_max, s: Pla
         y = L[..., 1]
         lo = np.where(m, y, np.inf).min(axis=1)
         hi = np.where(m, y, -np.inf).max(axis=1)
-        m_lo = (m & (y <= lo[:, None] + band)).astype(float)
-        m_hi = (m & (y >= hi[:, None] - band)).astype(float)
+        # The contact patch: points within a voxel of the outermost ones that face the pad. Points
+        # whose normal is (nearly) perpendicular to the closing axis — the top face next to a side
+        # face, say — are grazed, not pressed: blending their normals in would tilt the contact
+        # normal of every thin object and make the score hinge on which grid row a window catches.
+        n_y = np.einsum("nj,kj->kn", N, R[:, :, 1])  # each point's normal along each grasp's closing axis
+        m_lo = (m & (y <= lo[:, None] + band) & (n_y < -MIN_FACING)).astype(float)
+        m_hi = (m & (y >= hi[:, None] - band) & (n_y > MIN_FACING)).astype(float)
         support_lo, support_hi = m_lo.sum(axis=1), m_hi.sum(axis=1)
         edge = np.maximum(m_lo @ curv / np.maximum(support_lo, 1), m_hi @ curv / np.maximum(support_hi, 1))
         n_lo = m_lo @ N
