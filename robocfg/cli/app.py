@@ -7,7 +7,7 @@ import sys
 
 import typer
 
-from robocfg.cli import bench, ik, inspect_cmd, new_robot, robots, run, schema, validate
+from robocfg.cli import bench, ik, inspect_cmd, new_robot, robots, run, schema, validate, view
 
 app = typer.Typer(
     name="robocfg",
@@ -46,6 +46,7 @@ app.command("schema")(schema.schema)
 app.add_typer(run.run_app, name="run")
 app.command("ik")(ik.ik)
 app.add_typer(bench.bench_app, name="bench")
+app.command("view")(view.view)
 
 
 def main() -> None:

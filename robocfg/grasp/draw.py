@@ -51,19 +51,10 @@ class GraspRecorder(Recorder):
 
         img = Image.fromarray(frame)
         draw = ImageDraw.Draw(img)
-        M = self._matrix()
-        h, w = frame.shape[:2]
         for k, g in reversed(list(enumerate(self.grasps))):
             for line in grasp_polylines(g, getattr(self, "finger_length", 0.05)):
-                clip = np.c_[line, np.ones(len(line))] @ M.T
-                if np.any(clip[:, 3] <= 0):
+                px, front = self.project(line)
+                if not front.all():
                     continue
-                ndc = clip[:, :2] / clip[:, 3:4]
-                px = [((u + 1) / 2 * w, (1 - v) / 2 * h) for u, v in ndc]
-                draw.line(px, fill=BEST if k == 0 else OTHER, width=2 if k == 0 else 1)
+                draw.line([tuple(q) for q in px], fill=BEST if k == 0 else OTHER, width=2 if k == 0 else 1)
         return np.asarray(img)
-
-    def _matrix(self) -> np.ndarray:
-        """projection · view of the recorder's camera (row-major 4x4), as in ``Recorder.render``."""
-        view, proj = self.view_projection()
-        return np.asarray(proj, float).reshape(4, 4).T @ np.asarray(view, float).reshape(4, 4).T

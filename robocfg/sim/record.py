@@ -52,25 +52,15 @@ class Recorder:
 
     def view_projection(self) -> tuple[list[float], list[float]]:
         """PyBullet's (view, projection) matrices of the camera (column-major 16-lists)."""
-        w, h = self.size
-        cam, c = self.camera, self.world.client
-        if cam.eye is not None:
-            view = p.computeViewMatrix(list(cam.eye), list(cam.target), [0, 0, 1], physicsClientId=c)
-        else:
-            view = p.computeViewMatrixFromYawPitchRoll(list(cam.target), cam.distance, cam.yaw_deg, cam.pitch_deg,
-                                                       0.0, 2, physicsClientId=c)
-        proj = p.computeProjectionMatrixFOV(cam.fov_deg, w / h, 0.02, 20.0, physicsClientId=c)
-        return view, proj
+        return view_projection(self.world.client, self.camera, self.size)
+
+    def project(self, points) -> tuple[np.ndarray, np.ndarray]:
+        """Pixel coordinates of world points in this recorder's frames (see :func:`project`)."""
+        return project(points, self.world.client, self.camera, self.size)
 
     def render(self) -> np.ndarray:
         """One RGB frame (H, W, 3) uint8 from the current state."""
-        w, h = self.size
-        cam, c = self.camera, self.world.client
-        view, proj = self.view_projection()
-        img = p.getCameraImage(w, h, view, proj, renderer=p.ER_TINY_RENDERER, shadow=int(cam.shadow),
-                               lightDirection=list(cam.light_direction), physicsClientId=c)
-        rgba = np.reshape(np.asarray(img[2], dtype=np.uint8), (h, w, 4))
-        return rgba[:, :, :3].copy()
+        return render(self.world.client, self.camera, self.size)
 
     def capture(self) -> None:
         """Take a frame now (keeps only the last one when saving a .png)."""
@@ -105,6 +95,44 @@ class Recorder:
         return self.path
 
 
+def view_projection(client: int, camera: CameraView, size: tuple[int, int]) -> tuple[list[float], list[float]]:
+    """PyBullet's (view, projection) matrices of ``camera`` for a ``size`` = (W, H) image
+    (column-major 16-lists, as ``getCameraImage`` takes them)."""
+    w, h = size
+    if camera.eye is not None:
+        up = [0, 0, 1] if np.linalg.norm(np.cross(np.subtract(camera.target, camera.eye), [0, 0, 1])) > 1e-9 else [0, 1, 0]
+        view = p.computeViewMatrix(list(camera.eye), list(camera.target), up, physicsClientId=client)
+    else:
+        view = p.computeViewMatrixFromYawPitchRoll(list(camera.target), camera.distance, camera.yaw_deg,
+                                                   camera.pitch_deg, 0.0, 2, physicsClientId=client)
+    proj = p.computeProjectionMatrixFOV(camera.fov_deg, w / h, 0.02, 50.0, physicsClientId=client)
+    return view, proj
+
+
+def render(client: int, camera: CameraView, size: tuple[int, int]) -> np.ndarray:
+    """One RGB image (H, W, 3) uint8 of the client's bodies seen by ``camera`` (TinyRenderer)."""
+    w, h = size
+    view, proj = view_projection(client, camera, size)
+    img = p.getCameraImage(w, h, view, proj, renderer=p.ER_TINY_RENDERER, shadow=int(camera.shadow),
+                           lightDirection=list(camera.light_direction), physicsClientId=client)
+    rgba = np.reshape(np.asarray(img[2], dtype=np.uint8), (h, w, 4))
+    return rgba[:, :, :3].copy()
+
+
+def project(points, client: int, camera: CameraView, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """World points (N, 3) m → (pixels (N, 2) as (column, row) floats, in-front mask (N,)) in an
+    image rendered by :func:`render` with the same camera and size. TinyRenderer draws no debug
+    lines, so overlays are projected with this and drawn with Pillow."""
+    view, proj = view_projection(client, camera, size)
+    M = np.asarray(proj, float).reshape(4, 4).T @ np.asarray(view, float).reshape(4, 4).T
+    P = np.atleast_2d(np.asarray(points, float))
+    clip = np.c_[P, np.ones(len(P))] @ M.T
+    front = clip[:, 3] > 1e-9
+    ndc = clip[:, :2] / np.where(front, clip[:, 3], 1.0)[:, None]
+    w, h = size
+    return np.c_[(ndc[:, 0] + 1) / 2 * w, (1 - ndc[:, 1]) / 2 * h], front
+
+
 def facing_camera(target, side_axis, away_from, distance: float = 0.5, elevation_deg: float = 20.0) -> CameraView:
     """A camera looking at ``target`` from the horizontal direction perpendicular to ``side_axis``
     (e.g. a gripper's closing axis, so both fingers are seen side by side), on the side of ``target``
@@ -120,3 +148,27 @@ def facing_camera(target, side_axis, away_from, distance: float = 0.5, elevation
     e = np.radians(elevation_deg)
     eye = t + distance * (np.cos(e) * n + np.sin(e) * np.array([0.0, 0.0, 1.0]))
     return CameraView(target=tuple(t.tolist()), eye=tuple(eye.tolist()))
+
+
+def fit_camera(lo, hi, direction, fov_deg: float = 50.0, aspect: float = 4 / 3, margin: float = 1.08,
+               ) -> CameraView:
+    """A camera looking at the centre of the world box [``lo``, ``hi``] (m) from ``direction``
+    (a vector from the box towards the eye), just far enough away that every corner of the box is
+    in the picture (``margin`` > 1 leaves a border). Works for any robot size, a 1 m tabletop arm
+    or a 3 m KR210 on its pedestal alike."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    centre = (lo + hi) / 2
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    f = -d
+    u = np.cross(f, [0.0, 0.0, 1.0])
+    u = np.array([1.0, 0.0, 0.0]) if np.linalg.norm(u) < 1e-9 else u / np.linalg.norm(u)
+    v = np.cross(u, f)
+    tv = np.tan(np.radians(fov_deg) / 2)
+    th = tv * aspect
+    corners = np.array([[(hi if k >> a & 1 else lo)[a] for a in range(3)] for k in range(8)]) - centre
+    need = max(float(np.max(np.abs(corners @ u) / th - corners @ f)),
+               float(np.max(np.abs(corners @ v) / tv - corners @ f)), 1e-3)
+    dist = need * margin
+    eye = centre + dist * d
+    return CameraView(target=tuple(centre.tolist()), eye=tuple(eye.tolist()), fov_deg=fov_deg,
+                      distance=float(dist))

@@ -1,0 +1,1 @@
+"""See a robot YAML: a PNG sheet of its frames (``sheet``) and a browser viewer (``server``)."""

@@ -1,0 +1,45 @@
+"""What ``robocfg view`` shows: a robot YAML or a task YAML, found by path or by name.
+
+A name is looked up among the robots first, then the tasks (the search path of
+:mod:`robocfg.config.catalog`); a path's kind comes from its top-level keys.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+from robocfg.checks import CheckedRobot, CheckedTask, load_robot, load_task
+from robocfg.config import catalog
+from robocfg.config.load import detect_kind, load_yaml
+from robocfg.errors import NotFound
+
+
+@dataclass(frozen=True)
+class ViewSource:
+    """A robot or task YAML file to show."""
+
+    kind: Literal["robot", "task"]
+    path: Path
+
+    def load(self) -> CheckedRobot | CheckedTask:
+        """Load and check the file (ConfigError with FILE:LINE problems if it is invalid)."""
+        return load_robot(self.path) if self.kind == "robot" else load_task(self.path)
+
+    def robots(self, checked: CheckedRobot | CheckedTask) -> list[CheckedRobot]:
+        return [checked] if isinstance(checked, CheckedRobot) else list(checked.robots)
+
+
+def find_source(name_or_path: str) -> ViewSource:
+    """The robot or task YAML meant by ``name_or_path``."""
+    path = Path(name_or_path).expanduser()
+    if path.is_file():
+        kind = detect_kind(load_yaml(path))
+        return ViewSource("robot" if kind == "robot" else "task", path)
+    robots, tasks = catalog.available("robots"), catalog.available("tasks")
+    for kind, found in (("robot", robots), ("task", tasks)):
+        for name in (name_or_path, name_or_path.replace("-", "_"), Path(name_or_path).stem):
+            if name in found:
+                return ViewSource(kind, found[name])  # type: ignore[arg-type]
+    raise NotFound("robot or task", name_or_path, [*robots, *tasks])
