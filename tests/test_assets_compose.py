@@ -10,9 +10,10 @@ import pytest
 
 from robocfg.assets.compose import CompositionError, Part, compose
 from robocfg.assets.paths import Resolver
-from robocfg.assets.urdf import parse_urdf, rpy_matrix
+from robocfg.assets.urdf import parse_urdf
 from robocfg.checks import load_robot
 from robocfg.errors import ConfigError
+from robocfg.geometry import rpy_matrix
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -6,29 +6,8 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
-from robocfg.config.types import Pose, euler_deg_to_quat_xyzw
-
-
-def test_euler_deg_matches_pybullet():
-    import pybullet as p
-
-    rng = np.random.default_rng(0)
-    for rpy in rng.uniform(-180, 180, size=(50, 3)):
-        ours = np.asarray(euler_deg_to_quat_xyzw(list(rpy)))
-        ref = np.asarray(p.getQuaternionFromEuler(np.radians(rpy)))
-        assert min(np.abs(ours - ref).max(), np.abs(ours + ref).max()) < 1e-12
-
-
-def test_euler_is_rz_ry_rx():
-    import pybullet as p
-
-    r, pt, y = np.radians([30.0, -20.0, 75.0])
-    Rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
-    Ry = np.array([[np.cos(pt), 0, np.sin(pt)], [0, 1, 0], [-np.sin(pt), 0, np.cos(pt)]])
-    Rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
-    q = euler_deg_to_quat_xyzw([30.0, -20.0, 75.0])
-    R = np.asarray(p.getMatrixFromQuaternion(q)).reshape(3, 3)
-    assert np.allclose(R, Rz @ Ry @ Rx)
+from robocfg.config.types import Pose
+from robocfg.geometry import euler_deg_to_quat_xyzw
 
 
 def test_quaternion_orders_agree():

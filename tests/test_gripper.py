@@ -55,7 +55,7 @@ def test_grasp_holds_cube_with_contact_on_both_fingers(tmp_path):
         arm = w.robot.arm()
         g = arm.gripper
         tcp = arm.tcp_pose()
-        from robocfg.sim.frames import matrix_to_quat
+        from robocfg.geometry import matrix_to_quat
 
         cube = Body(name="cube", shape="box", size=[0.04, 0.04, 0.04], mass=0.1, position=tcp[:3, 3].tolist(),
                     quat_xyzw=matrix_to_quat(arm.ee_pose()[:3, :3]).tolist())

@@ -82,9 +82,9 @@ def test_zero_velocity_override_in_robot_yaml_is_a_config_error(tmp_path, capsys
 
 def test_cartesian_waypoints_use_ik_with_continuity(tmp_path):
     from robocfg.checks import load_task
+    from robocfg.geometry import pose_matrix
     from robocfg.kinematics.model import KinematicModel
     from robocfg.runners.trajectory import plan_task
-    from robocfg.sim.frames import pose_matrix
 
     poses = ["{position: [0.5, 0.1, 0.3], euler_deg: [180, 0, 0]}",
              "{position: [0.45, -0.1, 0.3], euler_deg: [180, 0, 30]}"]

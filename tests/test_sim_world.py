@@ -9,7 +9,7 @@ from _sim_helpers import DATA, PANDA, SHIPPED_ROBOTS, make_task
 
 from robocfg.config.scene import Body
 from robocfg.errors import ConfigError, PhysicsDiverged
-from robocfg.sim.frames import quat_to_matrix
+from robocfg.geometry import quat_to_matrix
 from robocfg.sim.world import World
 
 

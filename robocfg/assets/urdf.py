@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from robocfg.geometry import axis_angle_matrix, rpy_matrix
+
 MOVABLE = ("revolute", "continuous", "prismatic")
 
 
@@ -128,27 +130,10 @@ class Urdf:
         return out
 
 
-def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
-    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
-    a = axis / np.linalg.norm(axis)
-    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-
-
 def joint_motion(j: Joint, value: float) -> np.ndarray:
     T = np.eye(4)
     if j.type in ("revolute", "continuous"):
-        T[:3, :3] = axis_angle(j.axis, value)
+        T[:3, :3] = axis_angle_matrix(j.axis, value)
     elif j.type == "prismatic":
         T[:3, 3] = j.axis * value
     return T

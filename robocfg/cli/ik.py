@@ -39,7 +39,7 @@ def _target(position: tuple[float, float, float], euler_deg: tuple[float, float,
     except ValidationError as exc:
         raise ConfigError([Problem("<command line>", None, None, ".".join(str(x) for x in e["loc"]) or "pose",
                                    e["msg"]) for e in exc.errors()]) from None
-    from robocfg.sim.frames import pose_matrix
+    from robocfg.geometry import pose_matrix
 
     return pose_matrix(pose)
 

@@ -68,20 +68,12 @@ class Pose(Frozen):
         elif self.quat_wxyz is not None:
             w, x, y, z = self.quat_wxyz
         elif self.euler_deg is not None:
+            # Imported here: scipy is not needed (nor loaded) by `robocfg validate`.
+            from robocfg.geometry import euler_deg_to_quat_xyzw
+
             return euler_deg_to_quat_xyzw(self.euler_deg)
         else:
             return (0.0, 0.0, 0.0, 1.0)
         n = math.sqrt(x * x + y * y + z * z + w * w)
         return (x / n, y / n, z / n, w / n)
 
-
-def euler_deg_to_quat_xyzw(rpy_deg: list[float] | tuple[float, ...]) -> tuple[float, float, float, float]:
-    """Roll-pitch-yaw (deg, R = Rz·Ry·Rx, same as PyBullet's getQuaternionFromEuler) to (x, y, z, w)."""
-    r, p, y = (math.radians(v) / 2.0 for v in rpy_deg)
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return (
-        sr * cp * cy - cr * sp * sy,
-        cr * sp * cy + sr * cp * sy,
-        cr * cp * sy - sr * sp * cy,
-        cr * cp * cy + sr * sp * sy,
-    )

@@ -25,9 +25,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robocfg.geometry import rotation_angle
 from robocfg.grasp.gripper_model import CLOSING_TOLERANCE, GripperBoxes
 from robocfg.grasp.quality import epsilon
-from robocfg.kinematics.frames import Grasp, rotation_angle
+from robocfg.kinematics.frames import Grasp
 
 REASONS = ("not_antipodal", "too_wide", "collision", "slips_at_contact", "linkage_collision", "unreachable")
 APPROACH_ANGLES_DEG = (0.0, 30.0, -30.0, 60.0, -60.0)

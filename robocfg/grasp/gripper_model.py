@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
-from robocfg.sim.frames import pose_to_matrix
+from robocfg.geometry import pose_to_matrix
 
 CLOSING_SAMPLES = 9  # openings measured from open to closed (a Robotiq's pads move ≈ 10 mm between samples)
 CLOSING_TOLERANCE = 0.005  # m: a sample this much narrower than the grasp width still counts as reached

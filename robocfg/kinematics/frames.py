@@ -72,8 +72,3 @@ def top_down_grasps(center: np.ndarray, yaw: float, extent_xy: tuple[float, floa
     down = np.array([0.0, 0.0, -1.0])
     return [Grasp(np.asarray(center, float), grasp_rotation(down, s * closing), width) for s in (1.0, -1.0)]
 
-
-def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
-    """Angle (rad) of the rotation between two rotation matrices."""
-    c = (np.trace(Ra.T @ Rb) - 1.0) / 2.0
-    return float(np.arccos(np.clip(c, -1.0, 1.0)))

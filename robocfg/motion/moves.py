@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robocfg.kinematics.frames import rotation_angle
+from robocfg.geometry import rotation_angle
 
 CARTESIAN_STEP = 0.03  # m between IK waypoints on straight lines
 SETTLE_POLL = 4  # physics steps between convergence checks

@@ -11,17 +11,10 @@ import math
 import numpy as np
 
 from robocfg.config.commands import MOTION_TYPES, Motion
+from robocfg.geometry import axis_angle_matrix
 
 PLANE_AXES = {"xy": (0, 1), "yz": (1, 2), "xz": (0, 2)}
 DEFAULT_SEGMENT_TIME = 2.0  # s between waypoints when no times are given
-
-
-def _axis_angle(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z = axis / np.linalg.norm(axis)
-    c, s, C = math.cos(angle), math.sin(angle), 1.0 - math.cos(angle)
-    return np.array([[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
-                     [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
-                     [z * x * C - y * s, z * y * C + x * s, c + z * z * C]])
 
 
 class TargetMotion:
@@ -86,7 +79,7 @@ class TargetMotion:
         if self.orientation != "following" or self.follow_angle == 0.0:
             return self.R0.copy()
         angle = self.follow_angle * math.sin(2.0 * math.pi * t / self.m.period)
-        return _axis_angle(self.normal, angle) @ self.R0
+        return axis_angle_matrix(self.normal, angle) @ self.R0
 
     def pose(self, t: float) -> np.ndarray:
         T = np.eye(4)

@@ -22,9 +22,8 @@ import numpy as np
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import FollowObstacle, FollowTargetParams
 from robocfg.config.scene import Body
-from robocfg.config.types import euler_deg_to_quat_xyzw
 from robocfg.errors import RunFailed
-from robocfg.kinematics.frames import rotation_angle
+from robocfg.geometry import euler_deg_to_quat_xyzw, rotation_angle
 
 CLEARANCE_QUERY = 0.5  # m: clearances beyond this are reported as this value
 SAMPLE_RATE = 60.0  # Hz of the samples kept in the result
@@ -99,7 +98,7 @@ class FollowTargetResult:
 
 
 def _euler_matrix(rpy_deg) -> np.ndarray:
-    from robocfg.sim.frames import quat_to_matrix
+    from robocfg.geometry import quat_to_matrix
 
     return quat_to_matrix(euler_deg_to_quat_xyzw(rpy_deg))
 
@@ -153,10 +152,10 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
     """
     import pybullet
 
+    from robocfg.geometry import pose_matrix
     from robocfg.motion.reactive import EscapeSettings, ReactiveController, ReactiveSettings
     from robocfg.motion.reactive.setup import arm_spec, body_shape, scene_shapes
     from robocfg.motion.targets import TargetMotion
-    from robocfg.sim.frames import pose_matrix
     from robocfg.sim.loading import prepared_urdf
     from robocfg.sim.record import CameraView, Recorder
     from robocfg.sim.world import World

@@ -24,8 +24,9 @@ from robocfg.config.commands import GraspParams, Limits
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
 from robocfg.errors import RobocfgError
+from robocfg.geometry import rotation_angle
 from robocfg.grasp.antipodal import Candidate, PlannerSettings, PlanResult, plan_grasps
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, rotation_angle
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
 from robocfg.motion.moves import ArmMover, MoveFailed, bound_ik_by_iterations
 from robocfg.runners.grasp_report import (
     AttemptRecord,
@@ -69,7 +70,7 @@ def episode_setups(params: GraspParams, seed: int, episodes: int) -> list[Episod
         rng = np.random.default_rng([seed, k])
         dx, dy = rng.uniform(-1, 1, 2) * np.asarray(rz.xy_range)
         dyaw = math.radians(rng.uniform(-1, 1) * rz.yaw_range_deg)
-        from robocfg.sim.frames import matrix_to_quat, quat_to_matrix
+        from robocfg.geometry import matrix_to_quat, quat_to_matrix
 
         c, s_ = math.cos(dyaw), math.sin(dyaw)
         Rz = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])

@@ -215,7 +215,7 @@ def _worst(a: float | None, b: float | None) -> float | None:
 
 def _place_object(run: _Run, at: np.ndarray, R: np.ndarray):
     """Move the hold object to ``at`` with rotation ``R`` on a static support; returns (name, body, support Body)."""
-    from robocfg.sim.frames import matrix_to_quat
+    from robocfg.geometry import matrix_to_quat
 
     w, name = run.world, run.params.hold_object
     spec = next((b for b in w.task.config.scene.objects if b.name == name), None)

@@ -23,7 +23,8 @@ import numpy as np
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import Limits, PickPlaceParams
 from robocfg.config.scene import Body
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, rotation_angle, top_down_grasps
+from robocfg.geometry import rotation_angle
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, top_down_grasps
 from robocfg.motion.moves import ArmMover, MoveFailed, bound_ik_by_iterations
 from robocfg.runners.pick_place_report import (
     EpisodeResult,
@@ -337,7 +338,7 @@ class _StateMachine:
 
     @staticmethod
     def _tilt(quat) -> float:
-        from robocfg.sim.frames import quat_to_matrix
+        from robocfg.geometry import quat_to_matrix
 
         z = quat_to_matrix(quat)[:, 2]
         return math.degrees(math.acos(max(-1.0, min(1.0, float(z[2])))))

@@ -100,8 +100,8 @@ def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
 
     if not any(isinstance(w, Pose) for w in params.waypoints):
         return None
+    from robocfg.geometry import pose_to_matrix
     from robocfg.kinematics.model import KinematicModel
-    from robocfg.sim.frames import pose_to_matrix
 
     mount = task.config.robots[0]
     model = KinematicModel.from_robot(task.robots[0], arm_name, base_pose=pose_to_matrix(mount.position, mount.quaternion_xyzw()))

@@ -83,7 +83,7 @@ def spawn_table(client: int, table: Table) -> list[int]:
     ids = [spawn_body(client, top, Path("."), static=True)]
     leg_h = table.position[2] - sz
     if leg_h > 0.01:
-        from robocfg.sim.frames import quat_to_matrix
+        from robocfg.geometry import quat_to_matrix
 
         R = quat_to_matrix(table.quaternion_xyzw())
         for dx in (-1, 1):

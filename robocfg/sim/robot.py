@@ -27,7 +27,7 @@ from robocfg.checks.robot import CheckedRobot
 from robocfg.config.robot import ArmConfig, DriveGains
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import NotFound
-from robocfg.sim.frames import pose_to_matrix
+from robocfg.geometry import pose_to_matrix
 
 MOVABLE_TYPES = (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC)
 

@@ -31,8 +31,8 @@ from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
 from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError
+from robocfg.geometry import quat_to_matrix
 from robocfg.sim.bodies import spawn_body, spawn_ground, spawn_pedestal, spawn_table
-from robocfg.sim.frames import quat_to_matrix
 from robocfg.sim.gripper import make_gripper
 from robocfg.sim.loading import load_robot_urdf
 from robocfg.sim.mimic import MimicGears

@@ -13,9 +13,9 @@ from robocfg.config.commands import FollowObstacle
 from robocfg.config.scene import Body, Scene
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import RobocfgError
+from robocfg.geometry import pose_matrix
 from robocfg.motion.reactive.collision import EnvShape, LinkGeometry
 from robocfg.motion.reactive.controller import ArmSpec
-from robocfg.sim.frames import pose_matrix
 
 DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
 

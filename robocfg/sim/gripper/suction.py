@@ -15,7 +15,7 @@ import numpy as np
 import pybullet as p
 
 from robocfg.config.robot import SuctionGripperConfig
-from robocfg.sim.frames import matrix_to_pose, pose_to_matrix
+from robocfg.geometry import matrix_to_pose, pose_to_matrix
 from robocfg.sim.gripper.base import CLOSED, OPEN, Gripper
 from robocfg.sim.gripper.registry import register
 

@@ -1,0 +1,46 @@
+"""Rotation conversions (quaternion, roll-pitch-yaw, axis-angle, matrix) by scipy's ``Rotation``.
+
+Quaternions are ``(x, y, z, w)``; roll-pitch-yaw angles are extrinsic X-Y-Z (``R = Rz·Ry·Rx``),
+the convention of URDF ``rpy`` and of PyBullet's ``getQuaternionFromEuler``. Matrices are 3x3
+numpy arrays (float64).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+def quat_to_matrix(q: Sequence[float] | np.ndarray) -> np.ndarray:
+    """3x3 rotation of a quaternion ``(x, y, z, w)`` (normalised first)."""
+    return Rotation.from_quat(np.asarray(q, dtype=float)).as_matrix()
+
+
+def matrix_to_quat(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion ``(x, y, z, w)`` of a 3x3 rotation matrix, with ``w >= 0``."""
+    return Rotation.from_matrix(np.asarray(R, dtype=float)).as_quat(canonical=True)
+
+
+def euler_deg_to_quat_xyzw(rpy_deg: Sequence[float]) -> tuple[float, float, float, float]:
+    """Roll, pitch, yaw in degrees (``R = Rz·Ry·Rx``) to a unit quaternion ``(x, y, z, w)``."""
+    x, y, z, w = Rotation.from_euler("xyz", np.asarray(rpy_deg, dtype=float), degrees=True).as_quat()
+    return (float(x), float(y), float(z), float(w))
+
+
+def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:
+    """3x3 rotation of URDF roll, pitch, yaw in radians (``R = Rz(y)·Ry(p)·Rx(r)``)."""
+    return Rotation.from_euler("xyz", [r, p, y]).as_matrix()
+
+
+def axis_angle_matrix(axis: Sequence[float] | np.ndarray, angle: float) -> np.ndarray:
+    """3x3 rotation by ``angle`` (rad) about ``axis`` (any non-zero length; normalised here)."""
+    a = np.asarray(axis, dtype=float)
+    return Rotation.from_rotvec(a / np.linalg.norm(a) * float(angle)).as_matrix()
+
+
+def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> float:
+    """Angle (rad, in [0, π]) of the rotation that takes ``Ra`` to ``Rb``."""
+    c = (np.trace(np.asarray(Ra).T @ np.asarray(Rb)) - 1.0) / 2.0
+    return float(np.arccos(np.clip(c, -1.0, 1.0)))

@@ -1,0 +1,74 @@
+"""robocfg.geometry: rotation and pose conversions, checked against PyBullet's own maths."""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as p
+import pytest
+
+from robocfg.geometry import (
+    axis_angle_matrix,
+    euler_deg_to_quat_xyzw,
+    matrix_to_pose,
+    matrix_to_quat,
+    pose_matrix,
+    pose_to_matrix,
+    quat_to_matrix,
+    rotation_angle,
+    rpy_matrix,
+)
+
+
+def _random_quats(n: int, seed: int = 0) -> np.ndarray:
+    q = np.random.default_rng(seed).normal(size=(n, 4))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def test_euler_deg_matches_pybullet():
+    rng = np.random.default_rng(0)
+    for rpy in rng.uniform(-180, 180, size=(50, 3)):
+        ours = np.asarray(euler_deg_to_quat_xyzw(list(rpy)))
+        ref = np.asarray(p.getQuaternionFromEuler(np.radians(rpy)))
+        assert min(np.abs(ours - ref).max(), np.abs(ours + ref).max()) < 1e-12
+
+
+def test_rpy_is_rz_ry_rx():
+    r, pt, y = np.radians([30.0, -20.0, 75.0])
+    Rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
+    Ry = np.array([[np.cos(pt), 0, np.sin(pt)], [0, 1, 0], [-np.sin(pt), 0, np.cos(pt)]])
+    Rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
+    assert np.allclose(rpy_matrix(r, pt, y), Rz @ Ry @ Rx, atol=1e-12)
+    R = np.asarray(p.getMatrixFromQuaternion(euler_deg_to_quat_xyzw([30.0, -20.0, 75.0]))).reshape(3, 3)
+    assert np.allclose(R, Rz @ Ry @ Rx, atol=1e-12)
+
+
+def test_quat_to_matrix_matches_pybullet_and_round_trips():
+    for q in _random_quats(50):
+        R = quat_to_matrix(q)
+        assert np.allclose(R, np.asarray(p.getMatrixFromQuaternion(q.tolist())).reshape(3, 3), atol=1e-12)
+        back = matrix_to_quat(R)
+        assert back[3] >= 0.0  # one sign per rotation: the same rotation gives the same numbers
+        assert min(np.abs(back - q).max(), np.abs(back + q).max()) < 1e-12
+
+
+def test_axis_angle_matches_pybullet():
+    rng = np.random.default_rng(1)
+    for axis, angle in zip(rng.normal(size=(20, 3)), rng.uniform(-np.pi, np.pi, 20), strict=True):
+        ref = p.getQuaternionFromAxisAngle((axis / np.linalg.norm(axis)).tolist(), float(angle))
+        assert np.allclose(axis_angle_matrix(axis * 3.0, angle), quat_to_matrix(ref), atol=1e-12)
+
+
+def test_rotation_angle():
+    R = axis_angle_matrix([0.0, 1.0, 1.0], 0.7)
+    assert rotation_angle(np.eye(3), R) == pytest.approx(0.7, abs=1e-12)
+    assert rotation_angle(R, R) == pytest.approx(0.0, abs=1e-7)
+    assert rotation_angle(np.eye(3), axis_angle_matrix([1.0, 0.0, 0.0], np.pi)) == pytest.approx(np.pi)
+
+
+def test_pose_round_trip_and_config_pose():
+    from robocfg.config.types import Pose
+
+    T = pose_to_matrix([0.1, -0.2, 0.3], euler_deg_to_quat_xyzw([10.0, 20.0, 30.0]))
+    pos, quat = matrix_to_pose(T)
+    assert np.allclose(pose_to_matrix(pos, quat), T, atol=1e-12)
+    assert np.allclose(pose_matrix(Pose(position=[0.1, -0.2, 0.3], euler_deg=[10.0, 20.0, 30.0])), T, atol=1e-12)
