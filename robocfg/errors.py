@@ -52,7 +52,7 @@ class NotFound(RobocfgError):
     """A name (robot, task, frame, backend...) that does not exist; lists the names that do."""
 
     def __init__(self, kind: str, name: str, known: list[str]):
-        from robocfg.config.suggest import did_you_mean
+        from robocfg.suggest import did_you_mean
 
         self.kind, self.name, self.known = kind, name, list(known)
         hint = did_you_mean(name, known)

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import read_urdf_xml
-from robocfg.config.suggest import did_you_mean
+from robocfg.suggest import did_you_mean
 
 COMPOSER_VERSION = "1"
 UNDECLARED_NS = "urn:robocfg:undeclared:"

@@ -16,9 +16,9 @@ from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import Urdf, UrdfParseError, parse_urdf
 from robocfg.config.load import Loc, YamlDocument, load_yaml, validate_document
 from robocfg.config.robot import ArmConfig, ParallelGripperConfig, RobotConfig, SuctionGripperConfig
-from robocfg.config.suggest import did_you_mean
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import ConfigError, Problem
+from robocfg.suggest import did_you_mean
 
 ROT_TOL = 1e-6
 TCP_WARN_DIST = 0.010  # m

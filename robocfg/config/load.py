@@ -12,8 +12,8 @@ from typing import Any, TypeVar
 import yaml
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
-from robocfg.config.suggest import did_you_mean
 from robocfg.errors import ConfigError, Problem
+from robocfg.suggest import did_you_mean
 
 Loc = tuple[str | int, ...]
 M = TypeVar("M")

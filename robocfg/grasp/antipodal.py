@@ -254,7 +254,7 @@ def _closing_clear(cands: list[Candidate], boxes: GripperBoxes, s: PlannerSettin
     widths = np.array([c.grasp.width for c in cands])
     C = np.array([c.grasp.center for c in cands])
     R = np.array([c.grasp.rotation for c in cands])
-    gaps = sorted({g for g, *_ in boxes.samples}, reverse=True)
+    gaps = sorted({s.gap for s in boxes.samples}, reverse=True)
     # group by how far the fingers close: the number of samples at least as wide as the grasp
     reach = np.array([sum(g >= w - CLOSING_TOLERANCE for g in gaps) for w in widths])
     for n in np.unique(reach):

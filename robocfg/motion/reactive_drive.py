@@ -53,9 +53,9 @@ def build_reactive_drive(robot, world, arm_name: str, velocity_scale: float = 1.
     """Controller for arm ``arm_name`` of ``robot`` (a CheckedRobot) in ``world``'s task scene;
     ``velocity_scale`` scales the joint velocity limits (rad/s); ``payload`` = (distance of the held
     object's centre beyond the TCP along ``ee_axis``, bounding radius), both m."""
+    from robocfg.collision import LinkGeometry
     from robocfg.config.types import AXIS_INDEX
     from robocfg.motion.reactive import ReactiveController, ReactiveSettings
-    from robocfg.motion.reactive.collision import LinkGeometry
     from robocfg.motion.reactive.setup import arm_spec, scene_shapes
     from robocfg.sim.loading import prepared_urdf
 

@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robocfg.config.suggest import did_you_mean
 from robocfg.config.types import Pose
 from robocfg.errors import ConfigError, Problem, RunFailed
 from robocfg.geometry import pose_matrix
 from robocfg.motion.limits import JointLimits
+from robocfg.suggest import did_you_mean
 
 LIMIT_TOL = 1e-9
 IK_POS_TOL = 1e-3  # m

@@ -4,9 +4,9 @@ Protocol: ``n`` joint configurations drawn uniformly within the limits (seeded);
 the frame (``ee`` = ee_link by default); every query starts from the midpoint of the limits;
 success = position error ≤ 1e-5 m **and** rotation error ≤ 1e-5 rad **and** the answer within
 the joint limits; time budget 5 ms per query; times include failures. The same targets go, in
-the same run, to ``pybullet.calculateInverseKinematics`` (200 iterations, residual threshold
-1e-8, limits passed as lowerLimits/upperLimits/jointRanges/restPoses, rest pose = seed), whose
-answers are scored with the same FK. Returns typed results; printing is the CLI's job.
+the same run, to a reference solver handed in by the caller (the CLI passes
+``pybullet.calculateInverseKinematics`` from :mod:`robocfg.sim.ik_reference`), whose answers are
+scored with the same FK. Returns typed results; printing is the CLI's job.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import platform
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from time import perf_counter, process_time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
@@ -23,7 +23,6 @@ if TYPE_CHECKING:
     from robocfg.checks.robot import CheckedRobot
     from robocfg.kinematics.model import KinematicModel
 
-PYBULLET_ROW = "pybullet"
 TOL_POS, TOL_ROT = 1e-5, 1e-5  # m, rad
 LOOSE_POS, LOOSE_ROT = 1e-3, 1e-2  # m, rad
 
@@ -71,7 +70,14 @@ def make_targets(model: KinematicModel, n: int, seed: int, frame: str) -> tuple[
     return Q, [model.fk(q, frame) for q in Q]
 
 
-def _row(name: str, model: KinematicModel, targets: Sequence[np.ndarray], answers: Sequence[np.ndarray],
+class ReferenceSolver(Protocol):
+    """A reference IK run on the same targets: returns its :class:`BenchRow` (scored by :func:`score`)."""
+
+    def __call__(self, robot: CheckedRobot, model: KinematicModel, targets: Sequence[np.ndarray],
+                 seed_q: np.ndarray, frame: str) -> BenchRow: ...
+
+
+def score(name: str, model: KinematicModel, targets: Sequence[np.ndarray], answers: Sequence[np.ndarray],
          times: Sequence[float], cpu_s: float, frame: str, note: str = "") -> BenchRow:
     from robocfg.kinematics.ik.common import residuals
 
@@ -113,75 +119,14 @@ def run_backend(model: KinematicModel, backend: str, targets: Sequence[np.ndarra
         answers.append(res.q)
     solver.clock = perf_counter
     note = "budget on CPU time" if budget_clock == "cpu" else ""
-    return _row(backend, model, targets, answers, times, process_time() - c0, frame, note)
-
-
-def run_pybullet(robot: CheckedRobot, model: KinematicModel, targets: Sequence[np.ndarray], seed_q: np.ndarray,
-                 frame: str, max_iter: int = 200, threshold: float = 1e-8) -> BenchRow:
-    """``p.calculateInverseKinematics`` on the same targets (state reset to the seed before each call)."""
-    import pybullet as p
-
-    if frame not in ("ee", model.ee_link):
-        T_ee_frame = np.linalg.inv(model.fk(seed_q, "ee")) @ model.fk(seed_q, frame)
-    else:
-        T_ee_frame = np.eye(4)
-    cid = p.connect(p.DIRECT)
-    try:
-        body = p.loadURDF(str(robot.urdf_path), useFixedBase=True, physicsClientId=cid)
-        dof_index, link_index, lower, upper, rest = {}, {}, [], [], []
-        arm_set = set(model.joint_names)
-        for i in range(p.getNumJoints(body, physicsClientId=cid)):
-            info = p.getJointInfo(body, i, physicsClientId=cid)
-            name, jtype = info[1].decode(), info[2]
-            link_index[info[12].decode()] = i
-            if jtype == p.JOINT_FIXED:
-                continue
-            dof_index[name] = (len(lower), i)
-            if name in arm_set:
-                k = model.joint_names.index(name)
-                lo, hi, r = model.lower[k], model.upper[k], seed_q[k]
-            else:
-                v = model.locked.get(name, 0.0)
-                lo, hi, r = v, v, v
-            lower.append(float(lo))
-            upper.append(float(hi))
-            rest.append(float(r))
-        ranges = [max(h - lo, 1e-6) for lo, h in zip(lower, upper, strict=True)]
-        arm_dofs = [dof_index[n][0] for n in model.joint_names]
-        ee = link_index[model.ee_link]
-        state = {name: (rest[d], i) for name, (d, i) in dof_index.items()}
-        answers, times = [], []
-        cpu = 0.0
-        for T in targets:
-            T_ee = T @ np.linalg.inv(T_ee_frame)
-            for v, i in state.values():
-                p.resetJointState(body, i, v, physicsClientId=cid)
-            pos, quat = _pos_quat(T_ee)
-            c0, t0 = process_time(), perf_counter()
-            sol = p.calculateInverseKinematics(body, ee, pos, quat, lowerLimits=lower, upperLimits=upper,
-                                               jointRanges=ranges, restPoses=rest, maxNumIterations=max_iter,
-                                               residualThreshold=threshold, physicsClientId=cid)
-            times.append(perf_counter() - t0)
-            cpu += process_time() - c0
-            answers.append(np.array([sol[d] for d in arm_dofs]))
-    finally:
-        p.disconnect(cid)
-    note = f"calculateInverseKinematics, {max_iter} iterations, threshold {threshold:g}, limits passed"
-    return _row(PYBULLET_ROW, model, targets, answers, times, cpu, frame, note)
-
-
-def _pos_quat(T: np.ndarray) -> tuple[list[float], list[float]]:
-    import pinocchio as pin
-
-    q = pin.Quaternion(T[:3, :3].copy())
-    return T[:3, 3].tolist(), [q.x, q.y, q.z, q.w]
+    return score(backend, model, targets, answers, times, process_time() - c0, frame, note)
 
 
 def bench_ik(robot: CheckedRobot, n: int = 1000, backends: Sequence[str] | None = None, seed: int = 0,
-             time_budget: float = 0.005, frame: str = "ee", pybullet: bool = True,
+             time_budget: float = 0.005, frame: str = "ee", reference: ReferenceSolver | None = None,
              n_by_backend: dict[str, int] | None = None, budget_clock: str = "wall",
              progress: Callable[[str], None] | None = None) -> BenchResult:
-    """Run the protocol for ``backends`` (default: every registered one) and PyBullet's IK.
+    """Run the protocol for ``backends`` (default: every registered one) and ``reference`` (if given).
 
     ``n_by_backend`` lets a slow backend run on the first k targets only (its row says so).
     """
@@ -203,10 +148,10 @@ def bench_ik(robot: CheckedRobot, n: int = 1000, backends: Sequence[str] | None 
         if k < n:
             row.note = "; ".join(x for x in (row.note, f"first {k} of the {n} targets") if x)
         result.rows.append(row)
-    if pybullet:
+    if reference is not None:
         if progress:
-            progress(f"{PYBULLET_ROW}: {n} queries")
-        result.rows.append(run_pybullet(robot, model, targets, seed_q, frame))
+            progress(f"reference: {n} queries")
+        result.rows.append(reference(robot, model, targets, seed_q, frame))
     result.load_average = (load0, _load())
     return result
 

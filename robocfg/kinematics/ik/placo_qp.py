@@ -113,9 +113,8 @@ class PlacoSolver:
         """Add the robot's collision hulls (and the other arms', locked) and select the self pairs."""
         import pinocchio as pin
 
-        from robocfg.motion.reactive.collision import add_robot_geometry, robot_geometry_ids
-        from robocfg.motion.reactive.distances import DistanceField
-        from robocfg.motion.reactive.setup import robot_geometry
+        from robocfg.collision import DistanceField, robot_geometry
+        from robocfg.collision.shapes import add_robot_geometry, robot_geometry_ids
 
         geoms, _missing = robot_geometry(self.km.robot)  # links with unreadable meshes are not avoided
         g = self.robot.collision_model

@@ -6,7 +6,7 @@ Public API: :class:`ReactiveController`, :class:`ArmSpec`, :class:`ReactiveSetti
 Importing this package imports neither placo nor pinocchio; the controller does on construction.
 """
 
-from robocfg.motion.reactive.collision import EnvShape
+from robocfg.collision import EnvShape
 from robocfg.motion.reactive.controller import (
     ArmSpec,
     ReactiveController,

@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from robocfg.motion.reactive.collision import (
+from robocfg.collision.distances import DistanceField
+from robocfg.collision.shapes import (
     EnvShape,
     LinkGeometry,
     add_environment,
@@ -34,7 +35,6 @@ from robocfg.motion.reactive.collision import (
     set_environment_pose,
     to_convex_hulls,
 )
-from robocfg.motion.reactive.distances import DistanceField
 from robocfg.motion.reactive.escape import Blocking, EscapeRule, EscapeSettings
 from robocfg.motion.reactive.limits import step_bounds
 

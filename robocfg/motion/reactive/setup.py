@@ -9,12 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
+from robocfg.collision import EnvShape, robot_geometry
 from robocfg.config.commands import FollowObstacle
 from robocfg.config.scene import Body, Scene
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import RobocfgError
 from robocfg.geometry import pose_matrix
-from robocfg.motion.reactive.collision import EnvShape, LinkGeometry
 from robocfg.motion.reactive.controller import ArmSpec
 
 DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
@@ -52,29 +52,6 @@ def arm_spec(robot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = No
         velocity_limits=vel * velocity_scale, acceleration_limits=acc,
         posture=np.asarray(arm_cfg.home, float), other_joints=held, collision=collision,
     )
-
-
-def robot_geometry(robot) -> tuple[list[LinkGeometry], list[str]]:
-    """Every link's URDF collision geometry (meshes as scaled vertex clouds for convex hulls), and
-    the mesh files that could not be read (their links are then not avoided)."""
-    from robocfg.assets.meshes import read_vertices
-    from robocfg.assets.paths import Resolver, UnresolvedPath
-
-    resolver = Resolver(robot.path.parent, robot.config.package_dirs)
-    out: list[LinkGeometry] = []
-    missing: list[str] = []
-    for link in robot.urdf.links.values():
-        for g in link.collisions:
-            if g.kind == "mesh":
-                try:
-                    verts = read_vertices(resolver.mesh(g.filename or "", robot.urdf_path)) * np.asarray(g.scale)
-                except (UnresolvedPath, OSError, ValueError):
-                    missing.append(g.filename or link.name)
-                    continue
-                out.append(LinkGeometry(link.name, "mesh", g.origin, (), verts))
-            else:
-                out.append(LinkGeometry(link.name, g.kind, g.origin, tuple(g.size)))
-    return out, missing
 
 
 def body_shape(body: Body | FollowObstacle, obstacle: bool = True) -> EnvShape | None:

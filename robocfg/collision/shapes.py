@@ -1,4 +1,4 @@
-"""Collision model for reactive control: the robot's URDF collision geometry as convex hulls,
+"""Collision models for the collision-aware IK and reactive control: the robot's URDF collision geometry as convex hulls,
 plus environment shapes (obstacles, table, ground) fixed to the world (pinocchio universe joint).
 
 Distances come from coal (through pinocchio / placo). Frames: every pose is a 4×4 homogeneous
