@@ -5,9 +5,9 @@ import pybullet as p
 import pytest
 
 from robocfg.config.commands import Camera, GraspParams
-from robocfg.grasp.camera import backproject, capture, matrices, sees_box
 from robocfg.grasp.cloud import Cloud, crop, estimate_normals, from_rgbd, voxel_downsample
 from robocfg.grasp.perception import camera_warnings
+from robocfg.sim.camera import backproject, capture, matrices, sees_box
 
 HALF = np.array([0.05, 0.04, 0.03])
 CENTER = np.array([0.5, 0.0, 0.03])

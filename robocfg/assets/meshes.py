@@ -27,6 +27,8 @@ def read_vertices(path: Path) -> np.ndarray:
     import trimesh
 
     loaded = trimesh.load(str(path), force="mesh", process=False)
+    if not isinstance(loaded, trimesh.Trimesh):
+        raise ValueError(f"{path}: not a mesh trimesh can read")
     return np.asarray(loaded.vertices, dtype=float)
 
 

@@ -33,7 +33,7 @@ def bench_ik(
     from robocfg.errors import ConfigError, Problem
     from robocfg.kinematics.ik.bench import bench_ik as run
     from robocfg.kinematics.ik.registry import get_backend, known_backends
-    from robocfg.sim.ik_reference import pybullet_ik_row
+    from robocfg.sim.ik_reference import reference_row
 
     if budget_clock not in ("wall", "cpu"):
         raise ConfigError([Problem("<command line>", None, None, "--budget-clock", f"expected wall or cpu, got {budget_clock!r}")])
@@ -43,7 +43,7 @@ def bench_ik(
     checked = load_robot(catalog.find("robots", robot))
     err = console(stderr=True)
     result = run(checked, n=n, backends=names, seed=seed, time_budget=budget_ms / 1000.0, frame=frame,
-                 reference=None if no_pybullet else pybullet_ik_row, budget_clock=budget_clock,
+                 reference=None if no_pybullet else reference_row, budget_clock=budget_clock,
                  n_by_backend={"pink": n_slow, "placo": n_slow} if n_slow else None, progress=lambda msg: err.print(f"[dim]{msg}[/dim]"))
     table = Table(title=f"IK on {result.robot} ({frame} frame), n = {n}, budget {budget_ms:g} ms ({budget_clock}), seed {seed}")
     for col in ("backend", "success %", "≤1 mm/0.01 rad %", "outside limits %", "mean ms", "median ms", "p95 ms",

@@ -115,7 +115,7 @@ def _type_inner(prop: dict) -> str:
         return f"list of {item}{size}"
     if t == "object":
         return f"map name → {_type(prop['additionalProperties'])}" if isinstance(prop.get("additionalProperties"), dict) else "mapping"
-    return {"number": "float", "integer": "int", "string": "str", "boolean": "bool"}.get(t, str(t or "any"))
+    return {"number": "float", "integer": "int", "string": "str", "boolean": "bool"}.get(str(t), str(t or "any"))
 
 
 def _cell(text: str) -> str:

@@ -182,7 +182,7 @@ def _antipodal_pairs(P, N, w_max, s: PlannerSettings, rng, res: PlanResult, chun
     cos_cone = math.cos(math.atan(s.mu))
     seeds = rng.choice(n, size=min(s.num_candidates, n), replace=False)
     res.seeds = len(seeds)
-    out = []
+    out: list[tuple[np.ndarray, np.ndarray]] = []
     for a in range(0, len(seeds), chunk):
         S = seeds[a : a + chunk]
         D = P[None, :, :] - P[S][:, None, :]  # (k, n, 3)

@@ -41,7 +41,7 @@ class Cloud:
 
 
 def from_rgbd(rgbd) -> Cloud:
-    """The valid pixels of one :class:`~robocfg.grasp.camera.RGBD` as a cloud."""
+    """The valid pixels of one :class:`~robocfg.sim.camera.RGBD` as a cloud."""
     ok = np.isfinite(rgbd.depth) & np.all(np.isfinite(rgbd.points), axis=-1)
     pts = rgbd.points[ok]
     return Cloud(pts, rgbd.seg[ok].astype(np.int64), np.broadcast_to(rgbd.eye, pts.shape).copy())

@@ -103,7 +103,7 @@ def measure_gripper(robot: RobotHandle, arm: ArmHandle) -> GripperBoxes:
     m = measure_link_boxes(robot, arm, G_T_ee)
     lo, hi, names, finger = m.lo, m.hi, m.names, m.finger
     samples = [_sample(m, finger)]
-    if g is not None and hasattr(g, "reset"):
+    if g is not None:
         for f in np.linspace(1.0, 0.0, CLOSING_SAMPLES)[1:]:
             g.reset(float(f))
             s = measure_link_boxes(robot, arm, G_T_ee)

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from robocfg.config.commands import GraspParams
-from robocfg.grasp.camera import capture, look_direction, sees_box
 from robocfg.grasp.cloud import Cloud, crop, estimate_normals, from_rgbd, voxel_downsample
+from robocfg.sim.camera import capture, look_direction, sees_box
 
 COLLISION_VOXEL = 0.006  # m: leaf of the (coarser) scene cloud used for collision checks
 

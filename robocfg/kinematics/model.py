@@ -27,8 +27,11 @@ from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import NotFound, RobocfgError
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from robocfg.checks.robot import CheckedRobot
     from robocfg.kinematics.ik.result import IKResult
+    from robocfg.kinematics.ik.solver import IKSolver
 
 TCP_FRAME = "tcp"
 
@@ -76,7 +79,7 @@ class KinematicModel:
     locked: dict[str, float] = field(default_factory=dict)  # locked joint → value (rad or m)
     default_backend: str = "lm"
     robot: CheckedRobot | None = field(default=None, repr=False)  # source config (collision geometry for IK)
-    _solvers: dict = field(default_factory=dict, repr=False)
+    _solvers: dict[str, IKSolver] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         # OP_FRAME: a URDF link that happens to be called 'tcp' is a BODY frame and stays reachable by type
@@ -210,7 +213,7 @@ class KinematicModel:
     def ik(
         self,
         target: np.ndarray,
-        seed_q: np.ndarray | None = None,
+        seed_q: np.ndarray | Sequence[float] | None = None,
         frame: str = TCP_FRAME,
         backend: str | None = None,
         time_budget: float = 0.02,
@@ -227,12 +230,12 @@ class KinematicModel:
         """
         solver = self.solver(backend)
         return solver.solve(
-            target, seed_q=self.home if seed_q is None else seed_q, frame=frame,
+            target, seed_q=self.home if seed_q is None else np.asarray(seed_q, dtype=float), frame=frame,
             time_budget=time_budget, position_only=position_only,
             rng=rng,
         )
 
-    def solver(self, backend: str | None = None):
+    def solver(self, backend: str | None = None) -> IKSolver:
         """The (cached) solver instance of ``backend`` (default: the robot YAML's ``ik_backend``),
         e.g. to change its tolerances or its ``clock``."""
         from robocfg.kinematics.ik.registry import get_backend

@@ -17,10 +17,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robocfg.geometry import rotation_angle
+
+if TYPE_CHECKING:
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.limits import JointLimits
+    from robocfg.sim.gripper.base import Gripper
+    from robocfg.sim.robot import ArmHandle
+    from robocfg.sim.world import World
 
 CARTESIAN_STEP = 0.03  # m between IK waypoints on straight lines
 SETTLE_POLL = 4  # physics steps between convergence checks
@@ -29,12 +37,11 @@ DIRECT_TRAVEL_CHECK = 1.0  # rad: a point-to-point IK answer this far away is co
 IK_ITERATIONS = 400  # LM iterations per IK query over all restarts (see bound_ik_by_iterations)
 
 
-def bound_ik_by_iterations(model, iterations: int = IK_ITERATIONS) -> None:
+def bound_ik_by_iterations(model: KinematicModel, iterations: int = IK_ITERATIONS) -> None:
     """Make ``model``'s IK solver stop after ``iterations`` iterations (all restarts included)
-    instead of when its time budget runs out, where the backend supports it (``lm`` does)."""
-    solver = model.solver()
-    if hasattr(solver, "max_total_iter"):
-        solver.max_total_iter = iterations
+    instead of when its time budget runs out: every backend honours the budget, so the answers
+    do not depend on the machine's speed or load."""
+    model.solver().max_total_iter = iterations
 
 
 class MoveFailed(Exception):
@@ -51,10 +58,10 @@ class ArmMover:
     for timing; tolerances in m and rad; ``timeout`` (s) per move; ``on_step`` after every physics
     step (e.g. a recorder); ``phase`` names the current phase in failures."""
 
-    world: object
-    arm: object
-    model: object
-    limits: object
+    world: World
+    arm: ArmHandle
+    model: KinematicModel
+    limits: JointLimits
     position_tolerance: float = 0.005
     orientation_tolerance: float = 0.05
     timeout: float = 4.0
@@ -169,25 +176,30 @@ class ArmMover:
     def close_until_held(self, body: int, timeout: float) -> None:
         """Close the gripper; wait until both fingers touch ``body`` and the measured width is still
         for 0.1 s (or ``timeout`` s pass: then it must at least be held)."""
-        g = self.arm.gripper
+        g = self._gripper()
         t0 = self.world.t
         g.close()
-        measure = getattr(g, "width", None)
-        last, still = (measure() if measure else 0.0), 0.0
-        while not (g.is_grasping(body) and (measure is None or still >= 0.1)):
+        last = g.width()  # None: no fingers whose stillness could be awaited (suction)
+        still = 0.0
+        while not (g.is_grasping(body) and (last is None or still >= 0.1)):
             self.step(SETTLE_POLL)
-            if measure is not None:
-                w = measure()
+            w = g.width()
+            if w is not None and last is not None:
                 still = still + SETTLE_POLL * self.world.dt if abs(w - last) < 2e-4 else 0.0
-                last = w
+            last = w
             if self.world.t - t0 > timeout:
                 if g.is_grasping(body):
                     return
-                width = f" (width {measure() * 1000:.1f} mm)" if measure else ""
+                width = f" (width {w * 1000:.1f} mm)" if w is not None else ""
                 raise MoveFailed(self.phase, f"the object is not held{width}")
 
+    def _gripper(self) -> Gripper:
+        if self.arm.gripper is None:
+            raise MoveFailed(self.phase, f"arm {self.arm.config.name!r} has no gripper")
+        return self.arm.gripper
+
     def open_gripper(self, seconds: float = 0.4) -> None:
-        self.arm.gripper.open()
+        self._gripper().open()
         self.settle(seconds)
 
     def step(self, n: int) -> None:

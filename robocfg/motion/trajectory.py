@@ -77,7 +77,7 @@ class Piecewise(Trajectory):
                 out = [np.zeros((len(t), v.shape[1])) for v in vals]
             for o, v in zip(out, vals, strict=True):
                 o[sel] = v
-        return tuple(out)  # type: ignore[return-value]
+        return tuple(out)
 
 
 @dataclass

@@ -26,7 +26,7 @@ if TYPE_CHECKING:
 PYBULLET_ROW = "pybullet"
 
 
-def pybullet_ik_row(robot: CheckedRobot, model: KinematicModel, targets: Sequence[np.ndarray], seed_q: np.ndarray,
+def reference_row(robot: CheckedRobot, model: KinematicModel, targets: Sequence[np.ndarray], seed_q: np.ndarray,
                  frame: str, max_iter: int = 200, threshold: float = 1e-8) -> BenchRow:
     """``p.calculateInverseKinematics`` on the same targets (state reset to the seed before each call)."""
     import pybullet as p
@@ -38,7 +38,11 @@ def pybullet_ik_row(robot: CheckedRobot, model: KinematicModel, targets: Sequenc
     cid = p.connect(p.DIRECT)
     try:
         body = p.loadURDF(str(robot.urdf_path), useFixedBase=True, physicsClientId=cid)
-        dof_index, link_index, lower, upper, rest = {}, {}, [], [], []
+        dof_index: dict[str, tuple[int, int]] = {}
+        link_index: dict[str, int] = {}
+        lower: list[float] = []
+        upper: list[float] = []
+        rest: list[float] = []
         arm_set = set(model.joint_names)
         for i in range(p.getNumJoints(body, physicsClientId=cid)):
             info = p.getJointInfo(body, i, physicsClientId=cid)

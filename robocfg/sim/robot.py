@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pybullet as p
@@ -28,6 +28,10 @@ from robocfg.config.robot import ArmConfig, DriveGains
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import NotFound
 from robocfg.geometry import pose_to_matrix
+
+if TYPE_CHECKING:
+    from robocfg.sim.gripper.base import Gripper
+    from robocfg.sim.mimic import MimicGears
 
 MOVABLE_TYPES = (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC)
 
@@ -71,7 +75,7 @@ class RobotHandle:
         self.drives: dict[str, Drive] = {}
         self._fast: dict[tuple[str, ...], tuple] = {}
         self._drive_tokens: dict[tuple[str, ...], object] = {}
-        self.mimic: Any = None  # robocfg.sim.mimic.MimicGears, set by the World
+        self.mimic: MimicGears | None = None  # set by the World
         self.arms: dict[str, ArmHandle] = {a.name: ArmHandle(self, a) for a in self.config.arms}
 
     # ---- name lookups -------------------------------------------------------------------
@@ -108,10 +112,9 @@ class RobotHandle:
         states = p.getJointStates(self.body_id, idx, physicsClientId=self.client)
         return np.array([s[1] for s in states], dtype=float)
 
-    def reset_joints(self, names: Sequence[str], q: Sequence[float], hold: bool = True) -> None:
+    def reset_joints(self, names: Sequence[str], q: Sequence[float] | np.ndarray, hold: bool = True) -> None:
         """Teleport joints to ``q`` (zero velocity) and, if ``hold``, keep their drives there."""
-        q = np.asarray(q, dtype=float)
-        for n, i, v in zip(names, self.joint_indices(names), q, strict=True):
+        for n, i, v in zip(names, self.joint_indices(names), np.asarray(q, dtype=float), strict=True):
             p.resetJointState(self.body_id, i, float(v), 0.0, physicsClientId=self.client)
             if hold and n in self.drives:
                 self.drives[n].target = float(v)
@@ -122,10 +125,10 @@ class RobotHandle:
     def command_positions(
         self,
         names: Sequence[str],
-        q: Sequence[float],
-        velocities: Sequence[float] | None = None,
+        q: Sequence[float] | np.ndarray,
+        velocities: Sequence[float] | np.ndarray | None = None,
         gains: DriveGains | None = None,
-        forces: Sequence[float] | None = None,
+        forces: Sequence[float] | np.ndarray | None = None,
     ) -> None:
         """Drive ``names`` towards ``q`` (POSITION_CONTROL; non-blocking: ``world.step`` moves them).
 
@@ -147,14 +150,15 @@ class RobotHandle:
                 self._drive_tokens.clear()
         self._send(list(names))
 
-    def _command_fast(self, names: Sequence[str], q: Sequence[float], velocities: Sequence[float] | None) -> bool:
+    def _command_fast(self, names: Sequence[str], q: Sequence[float] | np.ndarray, velocities: Sequence[float] | np.ndarray | None) -> bool:
         """The per-step path: one motor call with gains cached per joint list. False → slow path
         (a joint without a drive yet, or with a speed cap)."""
         key = tuple(names)
         plan = self._fast.get(key)
         if plan is None or plan[0] is not self._drive_list(key):
-            drives = [self.drives.get(n) for n in key]
-            if any(d is None or d.max_velocity is not None for d in drives):
+            maybe = [self.drives.get(n) for n in key]
+            drives = [d for d in maybe if d is not None]
+            if len(drives) < len(maybe) or any(d.max_velocity is not None for d in drives):
                 return False
             plan = self._fast[key] = (
                 self._drive_list(key), [self.joint_index[n] for n in key], [d.position_gain for d in drives],
@@ -251,7 +255,7 @@ class ArmHandle:
     config: ArmConfig
     joints: list[str] = field(init=False)
     home: np.ndarray = field(init=False)
-    gripper: object | None = None  # a robocfg.sim.gripper Gripper, set by the World
+    gripper: Gripper | None = None  # set by the World
 
     def __post_init__(self) -> None:
         self.joints = self.robot.checked.arm_joints(self.config)
@@ -260,7 +264,7 @@ class ArmHandle:
     def joint_positions(self) -> np.ndarray:
         return self.robot.joint_positions(self.joints)
 
-    def command(self, q: Sequence[float], velocities: Sequence[float] | None = None) -> None:
+    def command(self, q: Sequence[float] | np.ndarray, velocities: Sequence[float] | np.ndarray | None = None) -> None:
         """Drive the arm joints to ``q`` (rad) with the robot YAML's arm gains."""
         self.robot.command_positions(self.joints, q, velocities)
 

@@ -146,8 +146,7 @@ class World:
         for arm in robot.arms.values():
             arm.gripper = make_gripper(self, arm)
             if arm.gripper is not None:
-                if hasattr(arm.gripper, "reset"):
-                    arm.gripper.reset(1.0)
+                arm.gripper.reset(1.0)
                 self._grippers.append(arm.gripper)
         robot.mimic.sync()
         return robot
@@ -261,7 +260,7 @@ class World:
         for robot in self.robots:
             for arm in robot.arms.values():
                 arm.command(arm.joint_positions())
-                if arm.gripper is not None and hasattr(arm.gripper, "reset"):
+                if arm.gripper is not None:
                     arm.gripper.reset(1.0)
             if robot.mimic is not None:
                 robot.mimic.sync()

@@ -7,5 +7,6 @@ QP), ``placo`` (placo's kinematics solver, with self-collision avoidance).
 
 from robocfg.kinematics.ik.registry import get_backend, known_backends, register
 from robocfg.kinematics.ik.result import IKResult
+from robocfg.kinematics.ik.solver import IKSolver
 
-__all__ = ["IKResult", "get_backend", "known_backends", "register"]
+__all__ = ["IKResult", "IKSolver", "get_backend", "known_backends", "register"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -93,10 +94,15 @@ def joints_at_limit(model: KinematicModel, q: np.ndarray) -> list[str]:
             if not w and (v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL)]
 
 
-def search(km: KinematicModel, descend, q0: np.ndarray, deadline: float,
-           rng: np.random.Generator | None, clock=None) -> tuple[np.ndarray, int, int]:
-    """Run ``descend(q, deadline) -> (converged, iterations, score, q)`` from ``q0``, then from
-    uniform random configurations, until one converges or the deadline passes.
+Descend = Callable[[np.ndarray, float, "int | None"], tuple[bool, int, float, np.ndarray]]
+
+
+def search(km: KinematicModel, descend: Descend, q0: np.ndarray, deadline: float,
+           rng: np.random.Generator | None, clock: Callable[[], float] | None = None,
+           max_total_iter: int | None = None) -> tuple[np.ndarray, int, int]:
+    """Run ``descend(q, deadline, cap) -> (converged, iterations, score, q)`` from ``q0``, then from
+    uniform random configurations, until one converges, the deadline passes or
+    ``max_total_iter`` iterations have been spent (``cap``: the iterations left, None: no cap).
 
     ``deadline`` is on ``clock`` (default ``time.perf_counter``).
     Returns (best q by score, total iterations, restarts).
@@ -108,11 +114,12 @@ def search(km: KinematicModel, descend, q0: np.ndarray, deadline: float,
     iters = restarts = 0
     q = q0
     while True:
-        ok, it, s, q_end = descend(q, deadline)
+        cap = None if max_total_iter is None else max_total_iter - iters
+        ok, it, s, q_end = descend(q, deadline, cap)
         iters += it
         if s < best_s:
             best_s, best_q = s, q_end
-        if ok or clock() >= deadline:
+        if ok or clock() >= deadline or (max_total_iter is not None and iters >= max_total_iter):
             return best_q, iters, restarts
         restarts += 1
         if rng is None:

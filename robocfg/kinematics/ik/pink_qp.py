@@ -39,11 +39,12 @@ class PinkSolver:
 
     def __init__(self, model: KinematicModel, tol_pos: float = 1e-5, tol_rot: float = 1e-5,
                  max_iter: int = 100, posture_cost: float = 1e-3, dt: float = 1.0,
-                 stall_ratio: float = 0.9, stall_n: int = 5):
+                 stall_ratio: float = 0.9, stall_n: int = 5, max_total_iter: int | None = None):
         import pink  # noqa: F401  (fail early if missing)
         from pink.limits import ConfigurationLimit, VelocityLimit
 
         self.km = model
+        self.max_total_iter = max_total_iter  # cap over all restarts (see IKSolver)
         self.tol_pos, self.tol_rot = tol_pos, tol_rot
         self.max_iter, self.posture_cost, self.dt = max_iter, posture_cost, dt
         self.stall_ratio, self.stall_n = stall_ratio, stall_n
@@ -62,14 +63,15 @@ class PinkSolver:
         posture = PostureTask(cost=self.posture_cost)
         posture.set_target(q0)
 
-        def descend(q: np.ndarray, deadline: float):
-            return self._descend(q, task, posture, Mt, fid, position_only, deadline)
+        def descend(q: np.ndarray, deadline: float, cap: int | None):
+            return self._descend(q, task, posture, Mt, fid, position_only, deadline, cap)
 
-        best_q, iters, restarts = search(km, descend, q0, self.clock() + time_budget, rng, self.clock)
+        best_q, iters, restarts = search(km, descend, q0, self.clock() + time_budget, rng, self.clock,
+                                         self.max_total_iter)
         return finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only, self.tol_pos, self.tol_rot,
                       t0, iters, restarts)
 
-    def _descend(self, q, task, posture, Mt, fid, position_only, deadline):
+    def _descend(self, q, task, posture, Mt, fid, position_only, deadline, cap: int | None = None):
         import pinocchio as pin
         from pink import Configuration, solve_ik
         from pink.exceptions import NoSolutionFound
@@ -77,7 +79,8 @@ class PinkSolver:
         km = self.km
         conf = Configuration(km.model, km.data, q.copy(), copy_data=False)
         best_s, best_q, ref_s, stall = math.inf, q, math.inf, 0
-        for it in range(1, self.max_iter + 1):
+        max_iter = self.max_iter if cap is None else min(self.max_iter, cap)
+        for it in range(1, max_iter + 1):
             d = conf.data.oMf[fid].actInv(Mt)
             pe = float(np.linalg.norm(d.translation))
             re = 0.0 if position_only else float(np.linalg.norm(pin.log3(d.rotation)))
@@ -101,4 +104,4 @@ class PinkSolver:
                 return False, it, best_s, best_q
             conf.integrate_inplace(v, self.dt)
             conf.update()
-        return False, self.max_iter, best_s, best_q
+        return False, max_iter, best_s, best_q

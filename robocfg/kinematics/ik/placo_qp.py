@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from time import perf_counter
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,6 +41,7 @@ from robocfg.kinematics.ik.common import (
 from robocfg.kinematics.ik.registry import register
 
 if TYPE_CHECKING:
+    from robocfg.collision import DistanceField
     from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
 
@@ -83,10 +84,11 @@ class PlacoSolver:
     def __init__(self, model: KinematicModel, tol_pos: float = 1e-5, tol_rot: float = 1e-5,
                  max_iter: int = 100, stall_ratio: float = 0.9, stall_n: int = 5,
                  self_collision: bool = True, margin: float = 0.02, trigger: float = 0.10,
-                 repair_iter: int = 20):
+                 repair_iter: int = 20, max_total_iter: int | None = None):
         import placo
 
         self.km = model
+        self.max_total_iter = max_total_iter  # cap over all restarts, repairs included (see IKSolver)
         self.tol_pos, self.tol_rot = tol_pos, tol_rot
         self.max_iter, self.stall_ratio, self.stall_n = max_iter, stall_ratio, stall_n
         self.repair_iter = repair_iter  # QP steps of a repair descent (each ≈ 0.3 ms: distances of every pair)
@@ -102,10 +104,10 @@ class PlacoSolver:
         self.solver.enable_joint_limits(True)
         self.solver.enable_velocity_limits(False)
         self.solver.dt = 1.0
-        self._task = None
-        self.field = None  # DistanceField over the self-collision pairs (None: avoidance off)
+        self._task: Any = None  # placo's frame or position task of the current query
+        self.field: DistanceField | None = None  # DistanceField over the self-collision pairs (None: avoidance off)
         self.pair_names: list[tuple[str, str]] = []
-        self._avoid = None  # placo's constraint while it is in the QP
+        self._avoid: Any = None  # placo's constraint while it is in the QP
         if self_collision and model.robot is not None:
             self._setup_self_collision(margin, trigger)
 
@@ -116,6 +118,8 @@ class PlacoSolver:
         from robocfg.collision import DistanceField, robot_geometry
         from robocfg.collision.shapes import add_robot_geometry, robot_geometry_ids
 
+        if self.km.robot is None:  # a model built from a bare URDF: no collision geometry known
+            return
         geoms, _missing = robot_geometry(self.km.robot)  # links with unreadable meshes are not avoided
         g = self.robot.collision_model
         add_robot_geometry(g, self.robot.model, geoms)
@@ -199,22 +203,25 @@ class PlacoSolver:
             self._task = self.solver.add_frame_task(name, T.copy())
         self._task.configure("target", "soft", 1.0)
 
-        def descend(q: np.ndarray, deadline: float):
+        def descend(q: np.ndarray, deadline: float, cap: int | None):
             self._set_avoid(False)
-            ok, it, s, q_end = self._descend(q, Mt, fid, position_only, deadline)
+            ok, it, s, q_end = self._descend(q, Mt, fid, position_only, deadline,
+                                             self.max_iter if cap is None else min(self.max_iter, cap))
             if not ok or self.field is None or not self.collides(q_end):
                 return ok, it, s, q_end
             # the answer penetrates: from it, move along the self-motion out of collision, keeping the pose
             ok2, it2 = False, 0
-            if self.repair_iter > 0:
+            repair = self.repair_iter if cap is None else min(self.repair_iter, cap - it)
+            if repair > 0:
                 self._set_avoid(True)
-                ok2, it2, s2, q2 = self._descend(q_end, Mt, fid, position_only, deadline, self.repair_iter)
+                ok2, it2, s2, q2 = self._descend(q_end, Mt, fid, position_only, deadline, repair)
             if ok2:
                 return ok2, it + it2, s2, q2
             return False, it + it2, s + 1.0, q_end  # penalised: any collision-free q ranks first
 
         self._set_avoid(False)
-        best_q, iters, restarts = search(km, descend, q0, self.clock() + time_budget, rng, self.clock)
+        best_q, iters, restarts = search(km, descend, q0, self.clock() + time_budget, rng, self.clock,
+                                         self.max_total_iter)
         self._set_avoid(False)
         res = finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only, self.tol_pos, self.tol_rot,
                      t0, iters, restarts)

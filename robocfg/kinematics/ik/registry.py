@@ -1,7 +1,8 @@
 """IK backends keyed by the robot YAML's ``ik_backend`` string (one dict).
 
-A backend is a factory ``(KinematicModel) -> solver`` where the solver has
-``solve(target, seed_q, frame, time_budget, position_only, rng) -> IKResult``. The built-in
+A backend is a factory ``(KinematicModel) -> IKSolver`` (:mod:`robocfg.kinematics.ik.solver`:
+``solve(target, seed_q, frame, time_budget, position_only, rng) -> IKResult`` and an iteration
+budget ``max_total_iter``). The built-in
 backends are registered when their module is imported; their heavy libraries (pink, placo) are
 imported only when a solver is built.
 """
@@ -10,11 +11,15 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
 
 from robocfg.errors import NotFound, RobocfgError
 
-BackendFactory = Callable[[Any], Any]
+if TYPE_CHECKING:
+    from robocfg.kinematics.ik.solver import IKSolver
+    from robocfg.kinematics.model import KinematicModel
+
+BackendFactory = Callable[["KinematicModel"], "IKSolver"]
 
 _REGISTRY: dict[str, BackendFactory] = {}
 _BUILTIN_MODULES = (

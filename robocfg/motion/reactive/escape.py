@@ -119,14 +119,16 @@ class EscapeRule:
         tangent = d - float(d @ n) * n
         side = _unit(np.cross(n, z))
         if side is None:  # n is vertical: sideways = horizontal, perpendicular to the motion
-            side = _unit(np.cross(z, d)) if _unit(np.cross(z, d)) is not None else np.array([0.0, 1.0, 0.0])
-        candidates = []
+            side = _unit(np.cross(z, d))
+            if side is None:
+                side = np.array([0.0, 1.0, 0.0])
+        candidates: list[np.ndarray | None] = []
         if np.linalg.norm(tangent) > 0.3 * np.linalg.norm(d):
             candidates.append(_unit(tangent))
         candidates += [_unit(z - float(z @ n) * n), _unit(self.s.up_weight * z + (1 - self.s.up_weight) * side),
                        _unit(self.s.up_weight * z - (1 - self.s.up_weight) * side), side, -side]
-        candidates = [c for c in candidates if c is not None]
-        feasible = [c for c in candidates if all(float(c @ m) >= -0.2 for m in normals)] or candidates
+        usable = [c for c in candidates if c is not None]
+        feasible = [c for c in usable if all(float(c @ m) >= -0.2 for m in normals)] or usable
         direction = feasible[self.attempts % len(feasible)]
         scale = 1.0 + 0.5 * self.attempts
         self.via = tcp + self.s.step * scale * direction + self.s.near * n

@@ -1,25 +1,37 @@
-"""Common interface of every gripper behaviour."""
+"""Common interface of every gripper behaviour: what callers may rely on without probing.
+
+Openings are fractions of the closed→open travel (0 closed, 1 open); widths are finger gaps in
+metres; forces in N (or N·m for revolute drives). Commands are non-blocking: the World calls
+``update()`` after every physics step.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
+
+from robocfg.errors import RobocfgError
 
 if TYPE_CHECKING:
+    from robocfg.config.robot import GripperConfig
     from robocfg.sim.robot import ArmHandle, RobotHandle
+    from robocfg.sim.world import World
 
 OPEN, CLOSED = 1.0, -1.0
 
 
 class Gripper:
-    """A gripper on one arm. Commands are non-blocking; the World calls ``update()`` every step."""
+    """A gripper on one arm. Subclasses implement every method that raises NotImplementedError;
+    the others have a meaning for every gripper and are overridden where the gripper can do more."""
 
     type_name: ClassVar[str] = ""
     grasps_at_surface: ClassVar[bool] = False  # True: holds an object by its surface (suction), not around it
 
-    def __init__(self, world: Any, arm: ArmHandle):
+    def __init__(self, world: World, arm: ArmHandle):
         self.world, self.arm = world, arm
         self.robot: RobotHandle = arm.robot
-        self.config = arm.config.gripper
+        if arm.config.gripper is None:
+            raise RobocfgError(f"arm {arm.config.name!r} has no gripper")
+        self.config: GripperConfig = arm.config.gripper
         self.client = self.robot.client
 
     def update(self) -> None:
@@ -31,11 +43,28 @@ class Gripper:
     def close(self) -> None:
         raise NotImplementedError
 
+    def reset(self, fraction: float = 1.0) -> None:
+        """Teleport to an opening ``fraction`` (1 open, 0 closed) and hold there, without dynamics
+        (between episodes, or to measure the gripper at several openings)."""
+        raise NotImplementedError
+
+    def set_force(self, force: float) -> None:
+        """Cap the grip force (N, or N·m). Grippers without a force setting (suction) ignore it."""
+
+    def fraction(self) -> float:
+        """Measured opening, 0 (closed) to 1 (open)."""
+        raise NotImplementedError
+
+    def width(self) -> float | None:
+        """Measured finger gap (m), or None for a gripper without fingers."""
+        return None
+
     def state(self) -> float:
         """1.0 (open) or −1.0 (closed)."""
         raise NotImplementedError
 
     def is_grasping(self, body: int | str) -> bool:
+        """True while ``body`` (a body id or a world body name) is held."""
         raise NotImplementedError
 
     def _body_id(self, body: int | str) -> int:

@@ -10,7 +10,7 @@ between ``closed`` (``min_width``) and ``open`` (``max_width``).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pybullet as p
@@ -19,6 +19,12 @@ from robocfg.config.robot import ParallelGripperConfig
 from robocfg.sim.gripper.base import CLOSED, OPEN, Gripper
 from robocfg.sim.gripper.registry import register
 from robocfg.sim.robot import Drive
+
+if TYPE_CHECKING:
+    from robocfg.checks.robot import CheckedRobot
+    from robocfg.config.robot import ArmConfig
+    from robocfg.sim.robot import ArmHandle
+    from robocfg.sim.world import World
 
 
 @register("parallel")
@@ -32,7 +38,7 @@ class ParallelGripper(Gripper):
 
     config: ParallelGripperConfig
 
-    def __init__(self, world: Any, arm: Any, rate: float | None = None):
+    def __init__(self, world: World, arm: ArmHandle, rate: float | None = None):
         super().__init__(world, arm)
         cfg: ParallelGripperConfig = self.config
         self.joints = self.robot.checked.gripper_joints(arm.config)
@@ -139,7 +145,7 @@ class ParallelGripper(Gripper):
         return all(p.getContactPoints(self.robot.body_id, bid, f, physicsClientId=self.client) for f in self.fingers)
 
 
-def _width_curve(checked: Any, arm_cfg: Any) -> tuple[np.ndarray, np.ndarray] | None:
+def _width_curve(checked: CheckedRobot, arm_cfg: ArmConfig) -> tuple[np.ndarray, np.ndarray] | None:
     """Pad gap vs opening fraction from the URDF, or None when it cannot be computed or is not
     monotonic (then ``set_width`` stays linear)."""
     from robocfg.assets.fingers import FingerGeometryMissing, closing_axis, width_curve
@@ -147,6 +153,8 @@ def _width_curve(checked: Any, arm_cfg: Any) -> tuple[np.ndarray, np.ndarray] | 
     from robocfg.config.types import AXIS_INDEX
 
     g = arm_cfg.gripper
+    if not isinstance(g, ParallelGripperConfig):
+        return None
     try:
         s, gaps = width_curve(checked.urdf, Resolver(checked.path.parent, checked.config.package_dirs), arm_cfg.ee_link,
                               AXIS_INDEX[arm_cfg.ee_axis], list(g.finger_links), checked.gripper_joints(arm_cfg),

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from robocfg.errors import NotFound, RobocfgError
 
 if TYPE_CHECKING:
     from robocfg.sim.gripper.base import Gripper
+    from robocfg.sim.robot import ArmHandle
+    from robocfg.sim.world import World
 
 GRIPPERS: dict[str, type[Gripper]] = {}
 
@@ -32,7 +34,7 @@ def gripper_class(type_name: str) -> type[Gripper]:
     return GRIPPERS[type_name]
 
 
-def make_gripper(world: Any, arm: Any) -> Gripper | None:
+def make_gripper(world: World, arm: ArmHandle) -> Gripper | None:
     """Build the gripper of ``arm`` (an ArmHandle) in ``world``; None when the arm has none."""
     if arm.config.gripper is None:
         return None

@@ -9,7 +9,7 @@ Constraint frames are given relative to the centres of mass, as PyBullet require
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pybullet as p
@@ -22,6 +22,10 @@ from robocfg.sim.gripper.registry import register
 CONSTRAINT_FORCE_FACTOR = 10.0  # the weld can push back up to this × hold_force; the check releases first
 LOAD_TIME_CONSTANT = 0.02  # s, low-pass of the estimated pull (one-step acceleration spikes are noise)
 
+if TYPE_CHECKING:
+    from robocfg.sim.robot import ArmHandle
+    from robocfg.sim.world import World
+
 
 @register("suction")
 class SuctionGripper(Gripper):
@@ -30,7 +34,7 @@ class SuctionGripper(Gripper):
     config: SuctionGripperConfig
     grasps_at_surface = True
 
-    def __init__(self, world: Any, arm: Any):
+    def __init__(self, world: World, arm: ArmHandle):
         super().__init__(world, arm)
         self.link = self.robot.link(self.config.link)
         self.active = False
@@ -56,6 +60,10 @@ class SuctionGripper(Gripper):
         """Back to the initial state (suction off, nothing attached); ``fraction`` is ignored."""
         self.off()
         self.released_by_load = False
+
+    def fraction(self) -> float:
+        """0.0 (closed) while suction is on, 1.0 (open) when off: a cup has no travel in between."""
+        return 0.0 if self.active else 1.0
 
     def state(self) -> float:
         """−1.0 (closed) while suction is on, 1.0 (open) when off."""
