@@ -7,7 +7,18 @@ import sys
 
 import typer
 
-from robocfg.cli import bench, ik, inspect_cmd, new_robot, robots, run, schema, validate, view
+from robocfg.cli import (
+    bench,
+    dataset,
+    ik,
+    inspect_cmd,
+    new_robot,
+    robots,
+    run,
+    schema,
+    validate,
+    view,
+)
 
 app = typer.Typer(
     name="robocfg",
@@ -47,6 +58,7 @@ app.add_typer(run.run_app, name="run")
 app.command("ik")(ik.ik)
 app.add_typer(bench.bench_app, name="bench")
 app.command("view")(view.view)
+app.add_typer(dataset.dataset_app, name="dataset")
 
 
 def main() -> None:

@@ -19,6 +19,13 @@ from robocfg.cli.common import (
     load_task_for,
     write_json,
 )
+from robocfg.cli.dataset_opts import (
+    DatasetFormatOpt,
+    DatasetFpsOpt,
+    DatasetOpt,
+    KeepOpt,
+    dataset_sink,
+)
 
 
 def run_pick_place(
@@ -34,12 +41,19 @@ def run_pick_place(
                                                help="Exit 1 when the success rate is below this.")] = 1.0,
     gui: GuiOpt = False,
     quiet: QuietOpt = False,
+    dataset: DatasetOpt = None,
+    dataset_format: DatasetFormatOpt = "lerobot",
+    dataset_fps: DatasetFpsOpt = 20,
+    keep: KeepOpt = "success",
 ) -> int:
     """Pick the task's object and place it, robot-agnostic (grasp → EE by R_ee_graspnet, ee_axis, tcp_offset).
 
     Exit 0 when the success rate reaches --min-success (default: every episode), 1 otherwise; the
     --json report (one record per episode; no wall-clock figures, so the same seed gives the same
-    file) is written either way.
+    file) is written either way. With --dataset every episode is recorded at --dataset-fps
+    (observations, the joint-target + gripper actions that drove the robot, phase labels, images of
+    the task's cameras) and the kept ones are written as a LeRobot v3.0 or robomimic HDF5 dataset;
+    `robocfg dataset replay` re-simulates an episode from those actions.
     """
     from robocfg.sim.quiet import quiet_import
 
@@ -52,6 +66,11 @@ def run_pick_place(
     for w in checked.warnings:
         console(stderr=True).print(w.format(), markup=False)
     recorder = _recorder_factory(record) if record else None
+    from robocfg.datasets.language import pick_place_instruction
+
+    run_seed = checked.config.sim.seed if seed is None else seed
+    sink = dataset_sink(dataset, dataset_format, dataset_fps, keep, checked, run_seed, arm, robot,
+                        pick_place_instruction(checked.config.pick_place))
     log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
     if episodes > 1 and not quiet:
         from rich.progress import (
@@ -71,11 +90,15 @@ def run_pick_place(
                 done["ok"] += res.success
                 bar.update(tid, advance=1, ok=f"{done['ok']} placed")
 
-            report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, tick)
+            report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, tick, sink=sink)
     else:
-        report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log)
+        report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, sink=sink)
+    written = sink.close() if sink is not None else None
     write_json(json_path, report)
     _print(report, timing, record, quiet)
+    if written is not None and not quiet:
+        out.print(f"dataset ({written.format}): {written.episodes_kept}/{written.episodes_run} episodes kept, "
+                  f"{written.frames} frames → {written.path}", markup=False)
     return 0 if report.summary.success_rate >= min_success else 1
 
 

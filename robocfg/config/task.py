@@ -6,6 +6,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
+from robocfg.config.cameras import TaskCamera
 from robocfg.config.commands import (
     FollowTargetParams,
     GraspParams,
@@ -37,6 +38,7 @@ class _TaskBase(Frozen):
     robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
     scene: Scene = Field(default_factory=Scene, description="Everything in the world besides the robots.")
     sim: Sim = Field(default_factory=Sim, description="Simulation settings.")
+    cameras: list[TaskCamera] = Field(default_factory=list, description="Cameras recorded into datasets (--dataset); none: state only.")
 
 
 class GripperTask(_TaskBase):

@@ -78,12 +78,14 @@ def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[Ep
 
 def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm: str | None = None,
                    gui: bool = False, record=None, record_episode: int = 0, log: Log | None = None,
-                   on_episode: Callable[[EpisodeResult], None] | None = None) -> tuple[PickPlaceReport, PickPlaceTiming]:
+                   on_episode: Callable[[EpisodeResult], None] | None = None,
+                   sink=None) -> tuple[PickPlaceReport, PickPlaceTiming]:
     """Run ``episodes`` episodes in one world, restored to the same snapshot before each; returns
     the report (deterministic for a seed) and wall times.
 
     ``record`` is a callable ``world -> Recorder`` used for episode ``record_episode``; ``log``
-    receives the phase log of episode 0.
+    receives the phase log of episode 0. ``sink`` (a :class:`robocfg.datasets.sink.DatasetSink`)
+    records every episode; its command gate then stands between the state machine and the drives.
     """
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import limits_from_robot
@@ -114,6 +116,8 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
             world.restore(state)
             recorder = record(world) if (record is not None and setup.index == record_episode) else None
             sm = _StateMachine(world, handle, tools, params, setup, recorder, log if setup.index == 0 else None)
+            if sink is not None:
+                sm.sink = sink.begin(world, handle, sm.obj, lambda sm=sm: sm.mover.phase)
             try:
                 sm.run()
                 failed, reason = None, "placed"
@@ -123,6 +127,8 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
             if recorder is not None:
                 recorder.save()
             res = sm.result(failed, reason)
+            if sm.sink is not None:
+                sink.end(sm.sink, setup.index, setup.seed, res.success, res.failed_phase, res.reason)
             timing.per_episode.append(time.perf_counter() - t0)
             timing.physics_per_episode.append(world.physics_seconds - physics0)
             results.append(res)
@@ -178,6 +184,7 @@ class _StateMachine:
         self.phases: list[PhaseRecord] = []
         self._phase: tuple[str, float] | None = None
         self.lift_rise: float | None = None
+        self.sink = None  # a dataset EpisodeRecorder: sees every physics step
 
     # ---- phases ------------------------------------------------------------------------------
     def run(self) -> None:
@@ -306,6 +313,8 @@ class _StateMachine:
 
     # ---- world helpers -----------------------------------------------------------------------
     def _on_step(self) -> None:
+        if self.sink is not None:
+            self.sink.on_step()
         if self.recorder is not None:
             self.recorder.maybe_capture()
 

@@ -1,0 +1,77 @@
+"""What one recorded episode holds, and what every episode of a dataset shares (its layout).
+
+Frames are taken every ``1 / fps`` s of simulated time, frame k at t = k / fps (frame 0 is the
+state the episode starts in). Per frame:
+
+* ``state`` (robot, base frame): arm joint positions (rad), gripper joint positions (rad or m),
+  arm joint velocities, gripper joint velocities, TCP position (m) and orientation (quaternion
+  x y z w) in the robot base frame, gripper opening (measured finger gap in m; for a gripper
+  without fingers, 1 = released, -1 = holding);
+* ``env_state``: the object's position (m) and orientation (quaternion x y z w) in the robot base
+  frame;
+* ``action``: the arm joint position targets (rad) that the drives reach at frame k + 1 (the
+  targets ramp linearly from action k - 1 to action k over the interval), then the gripper
+  command (+1 open, -1 close) applied from frame k on — exactly what drove the robot;
+* ``phase``: index into ``DatasetLayout.phases`` of the phase the runner was in;
+* one RGB image (and optional depth, m) per task camera.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+PICK_PLACE_PHASES = ("setup", "pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
+
+
+@dataclass(frozen=True)
+class CameraLayout:
+    """A camera's key and image size (pixels); ``depth``: a depth image is recorded too."""
+
+    name: str
+    height: int
+    width: int
+    depth: bool = False
+
+
+@dataclass(frozen=True)
+class DatasetLayout:
+    """Names of every vector entry, the frame rate (Hz), phases and cameras shared by all episodes."""
+
+    fps: int
+    robot: str
+    task_name: str
+    state_names: tuple[str, ...]
+    env_state_names: tuple[str, ...]
+    action_names: tuple[str, ...]
+    phases: tuple[str, ...] = PICK_PLACE_PHASES
+    cameras: tuple[CameraLayout, ...] = ()
+
+
+@dataclass
+class EpisodeRecord:
+    """One episode: per-frame arrays (length T) and its outcome.
+
+    ``physics_steps`` is how many physics steps the episode ran (replay runs the same number);
+    ``object_final`` is the object's final world position (m) and quaternion x y z w.
+    """
+
+    index: int
+    seed: int
+    language: str
+    success: bool
+    failed_phase: str | None
+    reason: str
+    physics_steps: int
+    object_final: list[float]
+    state: np.ndarray  # (T, len(state_names)) float32
+    env_state: np.ndarray  # (T, 7) float32
+    action: np.ndarray  # (T, len(action_names)) float32
+    phase: np.ndarray  # (T,) int64
+    images: dict[str, np.ndarray] = field(default_factory=dict)  # name -> (T, H, W, 3) uint8
+    depth: dict[str, np.ndarray] = field(default_factory=dict)  # name -> (T, H, W) float32, m
+
+    @property
+    def length(self) -> int:
+        return int(self.state.shape[0])

@@ -1,0 +1,77 @@
+"""The command gate: what the recorded actions are, and the only commands that reach the robot.
+
+While an episode is recorded (or replayed) the runner's arm and gripper commands do not go to the
+drives directly: the gate keeps the latest one, and at each dataset frame k (every
+``steps_per_frame`` physics steps) *latches* it as action k. Over the next interval the arm's
+position targets ramp linearly from action k - 1 to action k (target velocity = the ramp's slope)
+and the gripper command of action k is applied at once. Replay latches the recorded actions
+instead of the runner's, so recording and replay send identical motor commands.
+
+The price is a lag of one frame (50 ms at 20 Hz) between what the runner asks for and what the
+drives get; the runner's moves wait for convergence, so phases take slightly longer but succeed
+as before. Actions are rounded to float32 before use, as stored.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+OPEN, CLOSE = 1.0, -1.0
+
+
+class CommandGate:
+    """Intercepts ``arm.command`` and ``arm.gripper.open/close`` of one arm (see module doc)."""
+
+    def __init__(self, world, arm, steps_per_frame: int):
+        self.world, self.arm, self.gripper = world, arm, arm.gripper
+        self.steps_per_frame = steps_per_frame
+        drives = arm.robot.drives
+        self.q_wanted = np.array([drives[j].target if j in drives else q
+                                  for j, q in zip(arm.joints, arm.joint_positions(), strict=True)])
+        self.g_wanted = OPEN
+        self._g_applied = OPEN  # a restored world starts with the gripper reset open
+        self._prev = self._cur = self._round(np.append(self.q_wanted, OPEN))
+        self._real_command = arm.command
+        self._real_open = getattr(self.gripper, "open", None)
+        self._real_close = getattr(self.gripper, "close", None)
+
+    # ---- interception ------------------------------------------------------------------------
+    def install(self) -> None:
+        self.arm.command = self._want_arm
+        if self.gripper is not None:
+            self.gripper.open = lambda: self._want_gripper(OPEN)
+            self.gripper.close = lambda: self._want_gripper(CLOSE)
+
+    def remove(self) -> None:
+        self.arm.__dict__.pop("command", None)
+        if self.gripper is not None:
+            self.gripper.__dict__.pop("open", None)
+            self.gripper.__dict__.pop("close", None)
+
+    def _want_arm(self, q, velocities=None) -> None:
+        self.q_wanted = np.asarray(q, dtype=float).copy()
+
+    def _want_gripper(self, g: float) -> None:
+        self.g_wanted = g
+
+    # ---- frames ------------------------------------------------------------------------------
+    def latch(self, action: np.ndarray | None = None, first: bool = False) -> np.ndarray:
+        """Take action k (the runner's latest wish, or ``action`` on replay); returns it (float64
+        values exactly representable in float32)."""
+        a = self._round(np.append(self.q_wanted, self.g_wanted) if action is None else np.asarray(action))
+        self._prev, self._cur = (a if first else self._cur), a
+        g = float(a[-1])
+        if g != self._g_applied and self.gripper is not None:
+            (self._real_open if g > 0 else self._real_close)()
+            self._g_applied = g
+        return a
+
+    def drive(self, j: int) -> None:
+        """Send the arm targets for physics step ``j`` (1..steps_per_frame) of the current interval."""
+        n = self.steps_per_frame
+        d = self._cur[:-1] - self._prev[:-1]
+        self._real_command(self._prev[:-1] + (min(j, n) / n) * d, d / (n * self.world.dt))
+
+    @staticmethod
+    def _round(a: np.ndarray) -> np.ndarray:
+        return np.asarray(a, dtype=np.float32).astype(np.float64)

@@ -1,0 +1,22 @@
+"""The language instruction stored with every pick-place episode, from the task's object."""
+
+from __future__ import annotations
+
+import numpy as np
+
+# A few plain colour names (RGB 0..1): the object's colour is named after the nearest one.
+_COLOURS = {"red": (0.9, 0.1, 0.1), "green": (0.1, 0.7, 0.1), "blue": (0.1, 0.2, 0.9), "yellow": (0.9, 0.9, 0.1),
+            "orange": (1.0, 0.55, 0.0), "purple": (0.5, 0.1, 0.6), "white": (0.95, 0.95, 0.95),
+            "black": (0.05, 0.05, 0.05), "grey": (0.5, 0.5, 0.5)}
+
+
+def colour_name(rgba) -> str:
+    rgb = np.asarray(rgba[:3], float)
+    return min(_COLOURS, key=lambda k: float(np.sum((rgb - np.asarray(_COLOURS[k])) ** 2)))
+
+
+def pick_place_instruction(params) -> str:
+    """E.g. "pick the red cube and place it on the target" (``params``: PickPlaceParams)."""
+    obj = params.object
+    colour = f"{colour_name(obj.color)} " if getattr(obj, "color", None) else ""
+    return f"pick the {colour}{obj.name.replace('_', ' ')} and place it on the target"

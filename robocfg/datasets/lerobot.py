@@ -1,0 +1,200 @@
+"""A LeRobot v3.0 dataset writer with pyarrow and PyAV only (no torch, no lerobot).
+
+Layout (one chunk, one file each; LeRobot starts a new file past 100 MB of data or 200 MB of video,
+which a robocfg run reaches only at tens of thousands of episodes)::
+
+    meta/info.json                      codebase_version "v3.0", fps, features, totals, paths
+    meta/stats.json                     per-feature min/max/mean/std/count/q01..q99
+    meta/tasks.parquet                  task string (pandas index) -> task_index
+    meta/episodes/chunk-000/file-000.parquet   one row per episode: length, index ranges,
+                                        video time ranges, tasks, and robocfg's outcome columns
+    data/chunk-000/file-000.parquet     one row per frame
+    videos/<key>/chunk-000/file-000.mp4 every episode's frames of one camera, back to back
+
+Timestamps are ``frame_index / fps``; an episode's video frames start at its
+``videos/<key>/from_timestamp``. Videos: H.264 (libx264), yuv420p, a keyframe every 2 frames
+(LeRobot's own choice, for exact random access).
+"""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
+from robocfg.datasets.stats import ImageStats, vector_stats
+from robocfg.errors import RobocfgError
+
+CODEBASE_VERSION = "v3.0"
+DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
+EPISODES_PATH = "meta/episodes/chunk-000/file-000.parquet"
+VIDEO_CODEC = "libx264"
+STATE, ENV, ACTION = "observation.state", "observation.environment_state", "action"
+
+
+def image_key(camera: str) -> str:
+    return f"observation.images.{camera}"
+
+
+class LeRobotWriter:
+    """Add episodes one by one (videos are encoded as they come), then ``close()``."""
+
+    def __init__(self, root: Path, layout: DatasetLayout, extra_info: dict):
+        if any(c.depth for c in layout.cameras):
+            raise RobocfgError("depth images are written to --dataset-format hdf5 only; "
+                               "set 'depth: false' on the task's cameras for lerobot")
+        self.root, self.layout, self.extra_info = Path(root), layout, extra_info
+        self.root.mkdir(parents=True, exist_ok=True)
+        self.columns: dict[str, list[np.ndarray]] = {k: [] for k in (STATE, ENV, ACTION, "phase_index", "episode_index",
+                                                                     "frame_index", "task_index")}
+        self.episodes: list[dict] = []
+        self.tasks: dict[str, int] = {}
+        self.frames = 0
+        self.videos = {c.name: _VideoFile(self.root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
+                                                                        file_index=0), c.width, c.height, layout.fps)
+                       for c in layout.cameras}
+        self.image_stats = {c.name: ImageStats() for c in layout.cameras}
+
+    def add(self, ep: EpisodeRecord) -> None:
+        n, k = ep.length, len(self.episodes)
+        task_index = self.tasks.setdefault(ep.language, len(self.tasks))
+        for key, arr in ((STATE, ep.state), (ENV, ep.env_state), (ACTION, ep.action), ("phase_index", ep.phase)):
+            self.columns[key].append(arr)
+        self.columns["episode_index"].append(np.full(n, k, np.int64))
+        self.columns["frame_index"].append(np.arange(n, dtype=np.int64))
+        self.columns["task_index"].append(np.full(n, task_index, np.int64))
+        row = {"episode_index": k, "tasks": [ep.language], "length": n,
+               "data/chunk_index": 0, "data/file_index": 0,
+               "dataset_from_index": self.frames, "dataset_to_index": self.frames + n}
+        for name, video in self.videos.items():
+            key = image_key(name)
+            t0 = video.frames / self.layout.fps
+            video.write(ep.images[name])
+            self.image_stats[name].add(ep.images[name])
+            row |= {f"videos/{key}/chunk_index": 0, f"videos/{key}/file_index": 0,
+                    f"videos/{key}/from_timestamp": t0, f"videos/{key}/to_timestamp": t0 + n / self.layout.fps}
+        row |= {"meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0,
+                "success": ep.success, "failed_phase": ep.failed_phase, "reason": ep.reason, "seed": ep.seed,
+                "run_episode": ep.index, "physics_steps": ep.physics_steps, "object_final": ep.object_final}
+        self.episodes.append(row)
+        self.frames += n
+
+    def close(self) -> Path:
+        """Write the parquet files and metadata; returns the dataset root."""
+        for v in self.videos.values():
+            v.close()
+        fps = self.layout.fps
+        cols = {k: np.concatenate(v) if v else np.zeros(0) for k, v in self.columns.items()}
+        n = self.frames
+        dims = {STATE: len(self.layout.state_names), ENV: len(self.layout.env_state_names),
+                ACTION: len(self.layout.action_names)}
+        arrays = {key: _fixed_list(cols[key].reshape(n, d), d) for key, d in dims.items()}
+        arrays |= {
+            "timestamp": pa.array((cols["frame_index"] / fps).astype(np.float32)),
+            "frame_index": pa.array(cols["frame_index"].astype(np.int64)),
+            "episode_index": pa.array(cols["episode_index"].astype(np.int64)),
+            "index": pa.array(np.arange(n, dtype=np.int64)),
+            "task_index": pa.array(cols["task_index"].astype(np.int64)),
+            "phase_index": pa.array(cols["phase_index"].astype(np.int64)),
+        }
+        _write(pa.table(arrays), self.root / DATA_PATH.format(chunk_index=0, file_index=0))
+        _write(pa.Table.from_pylist(self.episodes) if self.episodes else pa.table({"episode_index": pa.array([], pa.int64())}),
+               self.root / EPISODES_PATH)
+        _write_tasks(self.tasks, self.root / "meta/tasks.parquet")
+        stats = {key: vector_stats(cols[key].reshape(n, d)) for key, d in dims.items()} if n else {}
+        if n:
+            for key in ("timestamp", "frame_index", "episode_index", "index", "task_index", "phase_index"):
+                stats[key] = vector_stats(np.asarray(arrays[key]))
+            stats |= {image_key(c): s.result() for c, s in self.image_stats.items()}
+        _json(self.root / "meta/stats.json", stats)
+        _json(self.root / "meta/info.json", self._info())
+        return self.root
+
+    def _info(self) -> dict:
+        lay = self.layout
+        scalar = {"dtype": "int64", "shape": [1], "names": None}
+        features = {
+            STATE: {"dtype": "float32", "shape": [len(lay.state_names)], "names": list(lay.state_names)},
+            ENV: {"dtype": "float32", "shape": [len(lay.env_state_names)], "names": list(lay.env_state_names)},
+            ACTION: {"dtype": "float32", "shape": [len(lay.action_names)], "names": list(lay.action_names)},
+        }
+        for c in lay.cameras:
+            features[image_key(c.name)] = {
+                "dtype": "video", "shape": [c.height, c.width, 3], "names": ["height", "width", "channels"],
+                "info": {"video.height": c.height, "video.width": c.width, "video.codec": "h264",
+                         "video.pix_fmt": "yuv420p", "video.is_depth_map": False, "video.fps": lay.fps,
+                         "video.channels": 3, "has_audio": False}}
+        features |= {"timestamp": {"dtype": "float32", "shape": [1], "names": None}, "frame_index": scalar,
+                     "episode_index": scalar, "index": scalar, "task_index": scalar, "phase_index": scalar}
+        return {
+            "codebase_version": CODEBASE_VERSION, "robot_type": lay.robot,
+            "total_episodes": len(self.episodes), "total_frames": self.frames, "total_tasks": len(self.tasks),
+            "chunks_size": 1000, "data_files_size_in_mb": 100, "video_files_size_in_mb": 200, "fps": lay.fps,
+            "splits": {"train": f"0:{len(self.episodes)}"}, "data_path": DATA_PATH,
+            "video_path": VIDEO_PATH if lay.cameras else None, "features": features,
+            "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, **self.extra_info},
+        }
+
+
+class _VideoFile:
+    """One MP4 that frames are appended to, frame i at pts i (time base 1/fps)."""
+
+    def __init__(self, path: Path, width: int, height: int, fps: int):
+        import av
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.container = av.open(str(path), "w")
+        self.stream = self.container.add_stream(VIDEO_CODEC, rate=fps, options={"g": "2", "crf": "23", "preset": "veryfast"})
+        self.stream.width, self.stream.height, self.stream.pix_fmt = width, height, "yuv420p"
+        self.stream.time_base = Fraction(1, fps)
+        self.frames = 0
+
+    def write(self, frames: np.ndarray) -> None:
+        import av
+
+        for rgb in frames:
+            f = av.VideoFrame.from_ndarray(rgb, format="rgb24")
+            f.pts = self.frames
+            self.frames += 1
+            self.container.mux(self.stream.encode(f))
+
+    def close(self) -> None:
+        self.container.mux(self.stream.encode(None))
+        self.container.close()
+
+
+def _fixed_list(x: np.ndarray, d: int) -> pa.Array:
+    return pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(x, np.float32).reshape(-1)), d)
+
+
+def _write(table: pa.Table, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    pq.write_table(table, path)
+
+
+def _write_tasks(tasks: dict[str, int], path: Path) -> None:
+    """``tasks.parquet`` as pandas writes a DataFrame indexed by the task string (LeRobot reads it
+    with ``pandas.read_parquet`` and looks tasks up by index)."""
+    names = sorted(tasks, key=tasks.get)
+    meta = {"index_columns": ["__index_level_0__"],
+            "column_indexes": [{"name": None, "field_name": None, "pandas_type": "unicode", "numpy_type": "object",
+                                "metadata": {"encoding": "UTF-8"}}],
+            "columns": [{"name": "task_index", "field_name": "task_index", "pandas_type": "int64", "numpy_type": "int64",
+                         "metadata": None},
+                        {"name": None, "field_name": "__index_level_0__", "pandas_type": "unicode",
+                         "numpy_type": "object", "metadata": None}],
+            "creator": {"library": "pyarrow", "version": pa.__version__}, "pandas_version": "2.2.3"}
+    table = pa.table({"task_index": pa.array([tasks[t] for t in names], pa.int64()),
+                      "__index_level_0__": pa.array(names, pa.string())})
+    _write(table.replace_schema_metadata({b"pandas": json.dumps(meta).encode()}), path)
+
+
+def _json(path: Path, obj: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(obj, indent=2) + "\n")

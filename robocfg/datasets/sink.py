@@ -1,0 +1,97 @@
+"""The dataset sink a runner feeds: one :class:`EpisodeRecorder` per episode, kept episodes to a
+writer (LeRobot v3.0 or robomimic HDF5).
+
+A runner calls ``recorder = sink.begin(world, arm, obj, phase_of)`` once the episode's world is
+ready (before its first command), ``recorder.on_step()`` after every physics step, and
+``sink.end(recorder, index, seed, success, failed_phase, reason)`` when the episode is over;
+``sink.close()`` after the last one writes the metadata.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal
+
+from robocfg.datasets.episode import CameraLayout, DatasetLayout
+from robocfg.datasets.recorder import EpisodeRecorder, layout_names
+
+Format = Literal["lerobot", "hdf5"]
+Keep = Literal["success", "all"]
+
+
+def make_writer(fmt: Format, root: Path, layout: DatasetLayout, extra_info: dict):
+    if fmt == "lerobot":
+        from robocfg.datasets.lerobot import LeRobotWriter
+
+        return LeRobotWriter(root, layout, extra_info)
+    from robocfg.datasets.hdf5 import Hdf5Writer
+
+    return Hdf5Writer(root, layout, extra_info)
+
+
+@dataclass(frozen=True)
+class DatasetSummary:
+    """What a sink wrote: path, format, episodes kept of those run, frames."""
+
+    path: str
+    format: str
+    episodes_kept: int
+    episodes_run: int
+    frames: int
+
+
+@dataclass
+class DatasetSink:
+    """Records every episode of a run; ``keep="success"`` writes only successful ones.
+
+    ``language``: the task string stored with every episode; ``extra_info``: run facts stored in
+    the dataset metadata (task path, arm, seed) that replay needs; ``renderer``: camera renderer.
+    """
+
+    root: Path
+    fmt: Format
+    task: object  # CheckedTask
+    fps: int = 20
+    keep: Keep = "success"
+    language: str = ""
+    extra_info: dict = field(default_factory=dict)
+    renderer: str = "tiny"
+    writer: object | None = field(default=None, init=False)
+    layout: DatasetLayout | None = field(default=None, init=False)
+    run: int = field(default=0, init=False)
+    kept: int = field(default=0, init=False)
+    frames: int = field(default=0, init=False)
+    _rig: tuple | None = field(default=None, init=False)
+
+    def begin(self, world, arm, obj: int, phase_of: Callable[[], str]) -> EpisodeRecorder:
+        from robocfg.sim.camera_rig import CameraRig
+
+        cams = self.task.config.cameras
+        if self.layout is None:
+            state, env, action = layout_names(arm)
+            self.layout = DatasetLayout(
+                fps=self.fps, robot=arm.robot.name, task_name=self.task.path.stem, state_names=state,
+                env_state_names=env, action_names=action,
+                cameras=tuple(CameraLayout(c.name, c.height, c.width, c.depth) for c in cams))
+            self.writer = make_writer(self.fmt, Path(self.root), self.layout, self.extra_info)
+        if self._rig is None or self._rig[0] is not world:
+            self._rig = (world, CameraRig(world, arm, cams, self.renderer))
+        rec = EpisodeRecorder(world, arm, obj, self.layout, self._rig[1], phase_of)
+        rec.start()
+        return rec
+
+    def end(self, rec: EpisodeRecorder, index: int, seed: int, success: bool, failed_phase: str | None,
+            reason: str) -> None:
+        ep = rec.finish(index, seed, self.language, success, failed_phase, reason)
+        self.run += 1
+        if success or self.keep == "all":
+            self.writer.add(ep)
+            self.kept += 1
+            self.frames += ep.length
+
+    def close(self) -> DatasetSummary:
+        if self.writer is not None:
+            self.writer.close()
+        return DatasetSummary(str(self.root), self.fmt, self.kept, self.run, self.frames)

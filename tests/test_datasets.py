@@ -1,0 +1,174 @@
+"""Datasets recorded from real pick-place runs: LeRobot v3.0 conformance (pyarrow + PyAV only),
+robomimic HDF5 layout, replay from the recorded actions, CLI errors."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import av
+import h5py
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+import yaml
+
+from robocfg.checks import load_task
+from robocfg.datasets.language import pick_place_instruction
+from robocfg.datasets.replay import replay_episode
+from robocfg.datasets.sink import DatasetSink
+from robocfg.runners.pick_place import run_pick_place
+from tests._cli import ROOT, run_main
+
+FPS = 10  # divides the 240 Hz physics rate; fewer rendered frames keep the test quick
+
+
+def _task_file(tmp: Path, depth: bool) -> Path:
+    """The shipped pick-place task with 32x32 cameras (a wrist camera with depth when asked)."""
+    doc = yaml.safe_load((ROOT / "tasks/pick_place.yaml").read_text())
+    for cam in doc["cameras"]:
+        cam["width"] = cam["height"] = 32
+    doc["cameras"][1]["depth"] = depth
+    path = tmp / "pick_place_small_cams.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+def _record(tmp: Path, fmt: str, episodes: int, depth: bool = False):
+    task = load_task(_task_file(tmp, depth))
+    root = tmp / f"ds_{fmt}"
+    sink = DatasetSink(root, fmt, task, fps=FPS, keep="all", language=pick_place_instruction(task.config.pick_place),
+                       extra_info={"task_path": str(task.path), "seed": 3, "arm": None, "robot_override": None})
+    report, _ = run_pick_place(task, episodes, seed=3, sink=sink)
+    sink.close()
+    return root, report
+
+
+@pytest.fixture(scope="module")
+def lerobot_ds(tmp_path_factory):
+    return _record(tmp_path_factory.mktemp("lr"), "lerobot", 2)
+
+
+def test_lerobot_layout_dtypes_and_index_ranges(lerobot_ds):
+    root, report = lerobot_ds
+    assert [e.success for e in report.episodes] == [True, True]  # recording keeps pick-place working
+    for rel in ("meta/info.json", "meta/stats.json", "meta/tasks.parquet", "meta/episodes/chunk-000/file-000.parquet",
+                "data/chunk-000/file-000.parquet", "videos/observation.images.scene/chunk-000/file-000.mp4",
+                "videos/observation.images.wrist/chunk-000/file-000.mp4"):
+        assert (root / rel).is_file(), rel
+    info = json.loads((root / "meta/info.json").read_text())
+    assert info["codebase_version"] == "v3.0" and info["fps"] == FPS and info["total_episodes"] == 2
+    feats = info["features"]
+    data = pq.read_table(root / "data/chunk-000/file-000.parquet")
+    assert data.num_rows == info["total_frames"]
+    for key in ("observation.state", "observation.environment_state", "action"):
+        t = data.schema.field(key).type
+        assert pa.types.is_fixed_size_list(t) and t.value_type == pa.float32()
+        assert t.list_size == feats[key]["shape"][0] == len(feats[key]["names"])
+    for key in ("frame_index", "episode_index", "index", "task_index", "phase_index"):
+        assert data.schema.field(key).type == pa.int64()
+    assert data.schema.field("timestamp").type == pa.float32()
+    assert np.array_equal(data["index"].to_numpy(), np.arange(data.num_rows))
+    np.testing.assert_allclose(data["timestamp"].to_numpy(), data["frame_index"].to_numpy() / FPS, atol=1e-6)
+    eps = pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").to_pylist()
+    ep_col = data["episode_index"].to_numpy()
+    frame_col = data["frame_index"].to_numpy()
+    start = 0
+    for k, e in enumerate(eps):
+        assert e["episode_index"] == k and e["dataset_from_index"] == start
+        assert e["dataset_to_index"] - start == e["length"] == int(np.sum(ep_col == k))
+        assert np.array_equal(frame_col[start:e["dataset_to_index"]], np.arange(e["length"]))
+        # one frame every 1/fps s of simulated time, frame 0 included, up to the last physics step
+        assert e["length"] == e["physics_steps"] // (240 // FPS) + 1
+        assert e["tasks"] == ["pick the red cube and place it on the target"]
+        start = e["dataset_to_index"]
+    # the actions really are joint targets the arm followed: the last one is where the arm is
+    act = np.asarray(data["action"].to_pylist())[:, :7]
+    state = np.asarray(data["observation.state"].to_pylist())[:, :7]
+    assert np.max(np.abs(act[eps[0]["length"] - 1] - state[eps[0]["length"] - 1])) < 0.02
+    phases = data["phase_index"].to_numpy()
+    assert set(info["robocfg"]["phases"][i] for i in np.unique(phases)) >= {"approach", "grasp", "transport", "retract"}
+
+
+def test_lerobot_videos_have_one_frame_per_row_at_index_over_fps(lerobot_ds):
+    root, _ = lerobot_ds
+    info = json.loads((root / "meta/info.json").read_text())
+    eps = pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").to_pylist()
+    for cam in ("scene", "wrist"):
+        key = f"observation.images.{cam}"
+        assert info["features"][key]["dtype"] == "video" and info["features"][key]["shape"] == [32, 32, 3]
+        with av.open(str(root / f"videos/{key}/chunk-000/file-000.mp4")) as c:
+            frames = list(c.decode(video=0))
+        assert len(frames) == info["total_frames"]
+        np.testing.assert_allclose([float(f.time) for f in frames], np.arange(len(frames)) / FPS, atol=1e-6)
+        assert frames[0].to_ndarray(format="rgb24").shape == (32, 32, 3)
+        for e in eps:
+            assert e[f"videos/{key}/from_timestamp"] == pytest.approx(e["dataset_from_index"] / FPS)
+            assert e[f"videos/{key}/to_timestamp"] == pytest.approx(e["dataset_to_index"] / FPS)
+
+
+def test_lerobot_stats_and_tasks(lerobot_ds):
+    root, _ = lerobot_ds
+    stats = json.loads((root / "meta/stats.json").read_text())
+    data = pq.read_table(root / "data/chunk-000/file-000.parquet")
+    state = np.asarray(data["observation.state"].to_pylist())
+    np.testing.assert_allclose(stats["observation.state"]["mean"], state.mean(0), rtol=1e-5, atol=1e-6)
+    assert stats["observation.state"]["count"] == [data.num_rows]
+    for k in ("min", "max", "mean", "std", "q01", "q50", "q99"):
+        assert np.asarray(stats["observation.images.scene"][k]).shape == (3, 1, 1)
+    tasks = pq.read_table(root / "meta/tasks.parquet")
+    meta = json.loads(tasks.schema.metadata[b"pandas"])
+    assert meta["index_columns"] == ["__index_level_0__"]
+    assert tasks.to_pydict() == {"task_index": [0], "__index_level_0__": ["pick the red cube and place it on the target"]}
+
+
+def test_replay_matches_and_tampered_actions_do_not(lerobot_ds, tmp_path):
+    root, report = lerobot_ds
+    r = replay_episode(root, 1)
+    assert r.matches and r.replayed_success and r.distance < 1e-3
+    assert r.replayed_object == pytest.approx(report.episodes[1].object_final, abs=1e-3)
+    # never closing the gripper: the same episode cannot place the cube, and replay says so
+    bad = tmp_path / "bad"
+    shutil.copytree(root, bad)
+    path = bad / "data/chunk-000/file-000.parquet"
+    t = pq.read_table(path)
+    act = np.asarray(t["action"].to_pylist(), np.float32)
+    act[:, -1] = 1.0
+    col = pa.FixedSizeListArray.from_arrays(pa.array(act.reshape(-1)), act.shape[1])
+    pq.write_table(t.set_column(t.schema.get_field_index("action"), "action", col), path)
+    r = replay_episode(bad, 1)
+    assert not r.matches and not r.replayed_success
+
+
+def test_hdf5_robomimic_layout(tmp_path):
+    root, report = _record(tmp_path, "hdf5", 1, depth=True)
+    with h5py.File(root / "data.hdf5", "r") as f:
+        demo = f["data/demo_0"]
+        n = demo.attrs["num_samples"]
+        assert f["data"].attrs["total"] == n
+        env = json.loads(f["data"].attrs["env_args"])
+        assert env["env_kwargs"]["robot"] == "panda" and env["env_kwargs"]["fps"] == FPS
+        assert demo["actions"].shape == (n, 8) and demo["actions"].dtype == np.float32
+        assert demo["obs/robot_state"].shape[0] == n and demo["obs/object_state"].shape == (n, 7)
+        assert demo["obs/scene_image"].shape == (n, 32, 32, 3) and demo["obs/scene_image"].dtype == np.uint8
+        depth = demo["obs/wrist_depth"][()]
+        assert depth.shape == (n, 32, 32) and 0.0 < float(depth.min()) < 1.0  # metres in front of the wrist
+        assert demo["states"].shape == (n, demo["obs/robot_state"].shape[1] + 7)
+        assert list(demo["dones"][()]).count(1) == 1 and demo["dones"][-1] == 1
+        assert demo["rewards"][-1] == float(report.episodes[0].success)
+        assert [x.decode() for x in f["mask/train"][()]] == ["demo_0"] and len(f["mask/valid"][()]) == 0
+    assert replay_episode(root, 0).matches
+
+
+def test_cli_dataset_info_and_errors(lerobot_ds, tmp_path, capsys, monkeypatch):
+    root, _ = lerobot_ds
+    code, out, _ = run_main(["dataset", "info", str(root)], capsys, monkeypatch)
+    assert code == 0 and "2/2 (100.0%)" in out and "observation.images.wrist" in out
+    code, _, err = run_main(["run", "pick-place", "--dataset", str(root)], capsys, monkeypatch)
+    assert code == 2 and "not empty" in err
+    code, _, err = run_main(["run", "pick-place", "--dataset", str(tmp_path / "x"), "--dataset-fps", "7"], capsys, monkeypatch)
+    assert code == 2 and "does not divide" in err
+    code, _, err = run_main(["dataset", "replay", str(root), "--episode", "5"], capsys, monkeypatch)
+    assert code == 2 and "has 2 episode(s)" in err
