@@ -61,8 +61,9 @@ class CommandGate:
         a = self._round(np.append(self.q_wanted, self.g_wanted) if action is None else np.asarray(action))
         self._prev, self._cur = (a if first else self._cur), a
         g = float(a[-1])
-        if g != self._g_applied and self.gripper is not None:
-            (self._real_open if g > 0 else self._real_close)()
+        real = self._real_open if g > 0 else self._real_close
+        if g != self._g_applied and real is not None:
+            real()
             self._g_applied = g
         return a
 

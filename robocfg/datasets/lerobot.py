@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 from fractions import Fraction
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 import pyarrow as pa
@@ -118,8 +119,8 @@ class LeRobotWriter:
 
     def _info(self) -> dict:
         lay = self.layout
-        scalar = {"dtype": "int64", "shape": [1], "names": None}
-        features = {
+        scalar: dict = {"dtype": "int64", "shape": [1], "names": None}
+        features: dict[str, dict] = {
             STATE: {"dtype": "float32", "shape": [len(lay.state_names)], "names": list(lay.state_names)},
             ENV: {"dtype": "float32", "shape": [len(lay.env_state_names)], "names": list(lay.env_state_names)},
             ACTION: {"dtype": "float32", "shape": [len(lay.action_names)], "names": list(lay.action_names)},
@@ -150,7 +151,8 @@ class _VideoFile:
 
         path.parent.mkdir(parents=True, exist_ok=True)
         self.container = av.open(str(path), "w")
-        self.stream = self.container.add_stream(VIDEO_CODEC, rate=fps, options={"g": "2", "crf": "23", "preset": "veryfast"})
+        self.stream: Any = cast(Any, self.container.add_stream(
+            VIDEO_CODEC, rate=fps, options={"g": "2", "crf": "23", "preset": "veryfast"}))
         self.stream.width, self.stream.height, self.stream.pix_fmt = width, height, "yuv420p"
         self.stream.time_base = Fraction(1, fps)
         self.frames = 0
@@ -181,7 +183,7 @@ def _write(table: pa.Table, path: Path) -> None:
 def _write_tasks(tasks: dict[str, int], path: Path) -> None:
     """``tasks.parquet`` as pandas writes a DataFrame indexed by the task string (LeRobot reads it
     with ``pandas.read_parquet`` and looks tasks up by index)."""
-    names = sorted(tasks, key=tasks.get)
+    names = sorted(tasks, key=lambda t: tasks[t])
     meta = {"index_columns": ["__index_level_0__"],
             "column_indexes": [{"name": None, "field_name": None, "pandas_type": "unicode", "numpy_type": "object",
                                 "metadata": {"encoding": "UTF-8"}}],

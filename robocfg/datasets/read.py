@@ -68,10 +68,10 @@ def read_info(root: Path) -> DatasetInfo:
 
         info = json.loads((root / "meta/info.json").read_text())
         eps = pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").to_pylist()
-        feats = {k: list(v["shape"]) for k, v in info["features"].items()}
+        shapes = {k: list(v["shape"]) for k, v in info["features"].items()}
         run = info.get("robocfg", {})
         return DatasetInfo(str(root), "lerobot", info["fps"], info.get("robot_type") or "", info["total_episodes"],
-                           info["total_frames"], sum(bool(e.get("success")) for e in eps), feats, run)
+                           info["total_frames"], sum(bool(e.get("success")) for e in eps), shapes, run)
     import h5py
 
     with h5py.File(_h5_path(root), "r") as f:

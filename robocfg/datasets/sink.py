@@ -12,10 +12,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from robocfg.datasets.episode import CameraLayout, DatasetLayout
 from robocfg.datasets.recorder import EpisodeRecorder, layout_names
+
+if TYPE_CHECKING:
+    from robocfg.sim.camera_rig import Renderer
 
 Format = Literal["lerobot", "hdf5"]
 Keep = Literal["success", "all"]
@@ -52,13 +55,13 @@ class DatasetSink:
 
     root: Path
     fmt: Format
-    task: object  # CheckedTask
+    task: Any  # a CheckedTask
     fps: int = 20
     keep: Keep = "success"
     language: str = ""
     extra_info: dict = field(default_factory=dict)
-    renderer: str = "tiny"
-    writer: object | None = field(default=None, init=False)
+    renderer: Renderer = "tiny"
+    writer: Any = field(default=None, init=False)
     layout: DatasetLayout | None = field(default=None, init=False)
     run: int = field(default=0, init=False)
     kept: int = field(default=0, init=False)

@@ -20,7 +20,7 @@ def vector_stats(x: np.ndarray) -> dict[str, list]:
         x = x[:, None]
     out = {"min": x.min(0), "max": x.max(0), "mean": x.mean(0), "std": x.std(0)}
     out.update({_qkey(q): np.quantile(x, q, axis=0) for q in QUANTILES})
-    res = {k: v.tolist() for k, v in out.items()}
+    res: dict[str, list] = {k: v.tolist() for k, v in out.items()}
     res["count"] = [int(x.shape[0])]
     return res
 
@@ -47,6 +47,6 @@ class ImageStats:
         out = {"min": [v[np.nonzero(h)[0][0]] for h in self.hist], "max": [v[np.nonzero(h)[0][-1]] for h in self.hist],
                "mean": mean, "std": std}
         out.update({_qkey(q): [v[int(np.searchsorted(cdf[c], q))] for c in range(3)] for q in QUANTILES})
-        res = {k: np.asarray(val, float).reshape(3, 1, 1).tolist() for k, val in out.items()}
+        res: dict[str, list] = {k: np.asarray(val, float).reshape(3, 1, 1).tolist() for k, val in out.items()}
         res["count"] = [self.frames]
         return res

@@ -35,10 +35,11 @@ class CameraRig:
         self.world, self.arm, self.cameras = world, arm, list(cameras)
         self._renderer = p.ER_TINY_RENDERER
         if renderer == "egl" and cameras:
-            import pkgutil
+            import importlib.util
 
-            egl = pkgutil.get_loader("eglRenderer")
-            plugin = p.loadPlugin(egl.get_filename(), "_eglRendererPlugin", physicsClientId=world.client) if egl else -1
+            spec = importlib.util.find_spec("eglRenderer")
+            origin = spec.origin if spec is not None else None
+            plugin = p.loadPlugin(origin, "_eglRendererPlugin", physicsClientId=world.client) if origin else -1
             if plugin < 0:
                 from robocfg.errors import RobocfgError
 
