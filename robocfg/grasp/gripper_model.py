@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.types import AXIS_INDEX
 
 if TYPE_CHECKING:
@@ -110,7 +111,8 @@ def measure_gripper(robot: RobotHandle, arm: ArmHandle) -> GripperBoxes:
             if s.names == names:
                 samples.append(_sample(s, finger))
         g.reset(1.0)
-    max_width = float(getattr(arm.config.gripper, "max_width", 0.0))
+    g_cfg = arm.config.gripper
+    max_width = g_cfg.max_width if isinstance(g_cfg, ParallelGripperConfig) else 0.0
     return GripperBoxes(lo, hi, names, finger, max_width, tuple(samples))
 
 

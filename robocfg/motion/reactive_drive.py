@@ -15,8 +15,15 @@ slightly more conservative than it needs to be).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from robocfg.checks.robot import CheckedRobot
+    from robocfg.config.scene import Body
+    from robocfg.motion.reactive import ReactiveController
+    from robocfg.sim.world import World
 
 REACTIVE_RATE = 120.0  # Hz: control rate of the free-space moves
 REACTIVE_MARGIN = 0.02  # m kept between the arm and the environment
@@ -28,13 +35,13 @@ class ReactiveDrive:
     """A built controller: ``substeps`` physics steps per control step; ``T_ee_tcp`` (4×4) maps the
     EE poses the movers use to the TCP poses the controller servos to."""
 
-    controller: object
+    controller: ReactiveController
     substeps: int
     T_ee_tcp: np.ndarray
     skipped: list[str]  # scene bodies the controller cannot avoid (meshes)
 
 
-def bounding_radius(body) -> float:
+def bounding_radius(body: Body) -> float:
     """Radius (m) of the sphere around a ``Body``'s centre that contains it."""
     s = body.size
     if body.shape in ("box", "mesh"):
@@ -46,7 +53,7 @@ def bounding_radius(body) -> float:
     return float(s[0] + s[1] / 2)  # capsule
 
 
-def build_reactive_drive(robot, world, arm_name: str, velocity_scale: float = 1.0,
+def build_reactive_drive(robot: CheckedRobot, world: World, arm_name: str, velocity_scale: float = 1.0,
                          payload: tuple[float, float] | None = None,
                          rate: float = REACTIVE_RATE, margin: float = REACTIVE_MARGIN,
                          max_speed: float = REACTIVE_MAX_SPEED) -> ReactiveDrive:

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import pybullet as p
 
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.geometry import pose_to_matrix
 
 if TYPE_CHECKING:
@@ -54,7 +55,7 @@ def measure_link_boxes(robot: RobotHandle, arm: ArmHandle, grasp_T_ee: np.ndarra
     below = _links_below(c, body, ee)
     T_ee = arm.ee_pose()
     G_T_world = grasp_T_ee @ np.linalg.inv(T_ee)
-    fingers = set(getattr(cfg.gripper, "finger_links", []) or [])
+    fingers = set(cfg.gripper.finger_links) if isinstance(cfg.gripper, ParallelGripperConfig) else set()
     touching = fingers | _rigid_parents(robot, fingers)
     lo, hi, names, finger, obbs = [], [], [], [], []
     for li in [ee, *below]:

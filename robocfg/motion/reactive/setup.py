@@ -6,21 +6,26 @@ Frames: world, 4×4 transforms, metres. Pure numpy + config (no PyBullet).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robocfg.collision import EnvShape, robot_geometry
 from robocfg.config.commands import FollowObstacle
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body, Scene
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import RobocfgError
 from robocfg.geometry import pose_matrix
 from robocfg.motion.reactive.controller import ArmSpec
 
+if TYPE_CHECKING:
+    from robocfg.checks.robot import CheckedRobot
+
 DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
 
 
-def arm_spec(robot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = None,
+def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = None,
              acceleration: float = 10.0, velocity_scale: float = 1.0,
              other_joints: dict[str, float] | None = None) -> ArmSpec:
     """``ArmSpec`` for ``arm`` of a ``CheckedRobot``: URDF limits (``drives`` overrides), TCP from
@@ -38,7 +43,7 @@ def arm_spec(robot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = No
     T_ee_tcp = np.eye(4)
     T_ee_tcp[AXIS_INDEX[arm_cfg.ee_axis], 3] = arm_cfg.tcp_offset
     held = dict(other_joints or {})
-    if other_joints is None and arm_cfg.gripper is not None and hasattr(arm_cfg.gripper, "open"):
+    if other_joints is None and isinstance(arm_cfg.gripper, ParallelGripperConfig):
         leaders = robot.gripper_joints(arm_cfg)
         held.update(zip(leaders, arm_cfg.gripper.open, strict=True))
         for j in urdf.joints.values():

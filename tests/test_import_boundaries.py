@@ -1,0 +1,27 @@
+"""Importing the planning layers does not start the simulator: the grasp planner, the IK
+benchmark protocol and the collision geometry load without pybullet, and config models load
+without scipy (so `robocfg validate` stays fast)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+
+def _loaded_after(imports: list[str], probes: list[str]) -> list[str]:
+    code = "; ".join(f"import {m}" for m in imports)
+    code += f"; import sys; print(','.join(p for p in {probes!r} if p in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return [p for p in out.stdout.strip().split(",") if p]
+
+
+def test_planners_do_not_load_pybullet() -> None:
+    mods = ["robocfg.grasp.antipodal", "robocfg.grasp.gripper_model", "robocfg.kinematics.ik.bench",
+            "robocfg.collision", "robocfg.motion.moves", "robocfg.geometry"]
+    assert _loaded_after(mods, ["pybullet"]) == []
+    assert _loaded_after(["robocfg.sim.link_boxes"], ["pybullet"]) == ["pybullet"]  # the probe can fail
+
+
+def test_config_models_do_not_load_scipy_or_simulators() -> None:
+    mods = ["robocfg.config.robot", "robocfg.config.task", "robocfg.config.types"]
+    assert _loaded_after(mods, ["scipy", "pybullet", "pinocchio", "placo"]) == []
