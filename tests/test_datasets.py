@@ -20,7 +20,7 @@ from robocfg.datasets.language import pick_place_instruction
 from robocfg.datasets.replay import replay_episode
 from robocfg.datasets.sink import DatasetSink
 from robocfg.runners.pick_place import run_pick_place
-from tests._cli import ROOT, run_main
+from _cli import ROOT, run_main
 
 FPS = 10  # divides the 240 Hz physics rate; fewer rendered frames keep the test quick
 
