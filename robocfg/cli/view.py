@@ -30,6 +30,7 @@ def view(
         out = write_sheet(source, png, q=joints, collision=collision)
         console().print(f"wrote {out}", markup=False)
         return
-    from robocfg.errors import RobocfgError
+    from robocfg.viewer.server import serve
 
-    raise RobocfgError("the browser viewer is not available yet: give --png FILE")
+    serve(source, host=host, port=port, q=joints, on_ready=lambda url: console().print(
+        f"robocfg view: open {url} in a browser (Ctrl-C to stop)", markup=False))

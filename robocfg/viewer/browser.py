@@ -1,0 +1,247 @@
+"""The browser viewer of ``robocfg view``: a viser page showing the robot(s) with their real
+meshes, the frames of :mod:`robocfg.viewer.frames`, joint sliders, a collision-shape toggle, and
+a target gizmo the first arm follows by our own IK (``KinematicModel.ik``).
+
+viser (not meshcat) because it serves its client from the wheel (no download, works on a headless
+machine through an SSH tunnel), has GUI widgets (sliders, checkboxes, markdown) and a transform
+gizmo, and draws URDFs from yourdfpy, which robocfg already uses. Meshes come from the same URDF
+PyBullet loads (``package://`` resolved, attachments composed). Poses: world frame, metres; a task
+YAML's robots stand at their mounts, with its table, pedestal, objects, obstacles and place target.
+
+``reload()`` rebuilds the page from the YAML; when the YAML is invalid the page shows its
+``FILE:LINE:COL: field: message`` lines instead (``errors`` holds them).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import partial
+
+import numpy as np
+
+from robocfg.checks import CheckedRobot
+from robocfg.errors import ConfigError
+from robocfg.sim.frames import matrix_to_quat, pose_matrix, pose_to_matrix
+from robocfg.viewer.frames import BOX_EDGES, ArmFrames, arm_frames, pad_boxes_ee
+from robocfg.viewer.scenery import add_scenery
+from robocfg.viewer.source import ViewSource
+
+LABEL_ANCHORS = ("bottom-left", "top-left", "bottom-right", "top-right")  # base, ee_link, TCP, grasp: apart
+
+
+def wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
+    """viser's (w, x, y, z) quaternion of a rotation matrix."""
+    x, y, z, w = matrix_to_quat(R)
+    return (float(w), float(x), float(y), float(z))
+
+
+@dataclass
+class ShownRobot:
+    """One robot on the page: its config, mount (4x4 world_T_root), URDF (yourdfpy) and joints."""
+
+    checked: CheckedRobot
+    mount: np.ndarray
+    node: str
+    urdf: object  # yourdfpy.URDF
+    shown: object  # viser.extras.ViserUrdf
+    q: dict[str, float] = field(default_factory=dict)  # actuated joint → value (rad or m)
+
+    def link_pose(self, link: str) -> np.ndarray:
+        """World pose (4x4) of ``link`` at the joint values last sent with :meth:`apply`."""
+        return self.mount @ self.urdf.get_transform(link, self.urdf.base_link)  # type: ignore[attr-defined]
+
+    def apply(self) -> None:
+        names = self.urdf.actuated_joint_names  # type: ignore[attr-defined]
+        self.shown.update_cfg(np.array([self.q.get(n, 0.0) for n in names]))  # type: ignore[attr-defined]
+
+
+class BrowserViewer:
+    """A viser server showing ``source``; see the module docstring."""
+
+    def __init__(self, source: ViewSource, host: str = "127.0.0.1", port: int = 8080,
+                 q: Sequence[float] | None = None):
+        import viser
+
+        self.source, self.q0 = source, None if q is None else list(q)
+        self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        self.lock = threading.RLock()
+        self.robots: list[ShownRobot] = []
+        self.frames: list[ArmFrames] = []
+        self.sliders: dict[str, object] = {}
+        self.errors: list[str] = []
+        self.watched: list = [source.path]
+        self.ik_status = ""
+        self._model = None
+        self._syncing = False
+        self.reload()
+
+    @property
+    def url(self) -> str:
+        return f"http://{self.server.get_host()}:{self.server.get_port()}"
+
+    # ---- building -----------------------------------------------------------------------
+    def reload(self) -> None:
+        """Rebuild the page from the YAML (or show its errors)."""
+        with self.lock:
+            self.server.scene.reset()
+            self.server.gui.reset()
+            self.robots, self.frames, self.sliders, self._model = [], [], {}, None
+            try:
+                checked = self.source.load()
+            except ConfigError as exc:
+                self.errors = [p.format() for p in exc.problems]
+                text = "\n".join(self.errors)
+                self.server.gui.add_markdown(f"**{self.source.path.name} is invalid** (fix it and save):\n\n```\n{text}\n```")
+                return
+            self.errors = []
+            robots = self.source.robots(checked)
+            self.watched = [self.source.path, *(r.path for r in robots)]
+            mounts = [np.eye(4)] if self.source.kind == "robot" else [pose_matrix(m) for m in checked.config.robots]
+            if self.source.kind == "task":
+                add_scenery(self.server, checked)
+            for k, (robot, mount) in enumerate(zip(robots, mounts, strict=True)):
+                self.robots.append(self._add_robot(robot, mount, f"/robot{k}"))
+            self._add_gui()
+            self.refresh()
+            self._fit_camera()
+
+    def _fit_camera(self) -> None:
+        """Ground grid and initial camera sized to the robots (a 3 m KR210 as well as a Panda)."""
+        pts = np.array([r.link_pose(link)[:3, 3] for r in self.robots for link in r.urdf.link_map])  # type: ignore[attr-defined]
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        size = float(max(np.max(hi - lo), 0.3))
+        centre = (lo + hi) / 2
+        cell = 0.1 if size < 2 else 0.25
+        self.server.scene.add_grid("/ground", width=3 * size, height=3 * size, cell_size=cell, section_size=5 * cell,
+                                   position=(float(centre[0]), float(centre[1]), 0.0))
+        self.server.initial_camera.look_at = tuple(centre)
+        self.server.initial_camera.position = tuple(centre + size * np.array([1.0, -0.85, 0.55]))
+
+    def _add_robot(self, robot: CheckedRobot, mount: np.ndarray, node: str) -> ShownRobot:
+        import yourdfpy
+        from viser.extras import ViserUrdf
+
+        from robocfg.sim.loading import prepared_urdf
+
+        path = prepared_urdf(robot)
+        urdf = yourdfpy.URDF.load(path, build_scene_graph=True, load_meshes=True, build_collision_scene_graph=True,
+                                  load_collision_meshes=True,
+                                  filename_handler=partial(yourdfpy.filename_handler_magic, dir=path.parent))
+        self.server.scene.add_frame(node, show_axes=False, position=tuple(mount[:3, 3]), wxyz=wxyz(mount[:3, :3]))
+        shown = ViserUrdf(self.server, urdf, root_node_name=node, load_collision_meshes=True,
+                          collision_mesh_color_override=(0.1, 0.7, 0.8, 0.5))
+        shown.show_collision = False
+        out = ShownRobot(robot, mount, node, urdf, shown)
+        for k, arm in enumerate(robot.config.arms):
+            q = self.q0 if (k == 0 and not self.robots and self.q0 is not None) else arm.home
+            out.q.update(zip(robot.arm_joints(arm), (float(v) for v in q), strict=True))
+            g = arm.gripper
+            if g is not None and hasattr(g, "open"):
+                out.q.update(zip(robot.gripper_joints(arm), g.open, strict=True))
+        return out
+
+    def _add_gui(self) -> None:
+        gui, first = self.server.gui, self.robots[0]
+        gui.add_markdown(f"**{self.source.path.name}** ({self.source.kind}) — frames: base, ee_link, TCP, "
+                         "grasp (x approach, y closing); magenta: ee_axis; orange: finger pads")
+        coll = gui.add_checkbox("collision shapes", False)
+
+        @coll.on_update
+        def _(_event) -> None:
+            for r in self.robots:
+                r.shown.show_collision = coll.value  # type: ignore[attr-defined]
+
+        self.collision_checkbox = coll
+        limits = first.shown.get_actuated_joint_limits()  # type: ignore[attr-defined]
+        with gui.add_folder("joints"):
+            for name in first.urdf.actuated_joint_names:  # type: ignore[attr-defined]
+                lo, hi = limits[name]
+                lo, hi = (-np.pi, np.pi) if lo is None or hi is None else (lo, hi)
+                s = gui.add_slider(name, min=float(lo), max=float(hi), step=float(hi - lo) / 200,
+                                   initial_value=float(np.clip(first.q.get(name, 0.0), lo, hi)))
+                s.on_update(partial(self._on_slider, name))
+                self.sliders[name] = s
+        self._ik_text = gui.add_markdown("drag the gizmo at the TCP: the first arm follows by IK")
+        T = first.link_pose(first.checked.config.arms[0].ee_link)
+        from robocfg.kinematics.frames import tcp_from_ee
+
+        T_tcp = tcp_from_ee(T, first.checked.config.arms[0])
+        size = float(np.clip(1.5 * first.checked.config.arms[0].tcp_offset, 0.08, 0.5))
+        self.target = self.server.scene.add_transform_controls("/target", scale=size, position=tuple(T_tcp[:3, 3]),
+                                                               wxyz=wxyz(T_tcp[:3, :3]))
+        self.target.on_update(lambda _event: self.follow_target())
+
+    # ---- updates ------------------------------------------------------------------------
+    def _on_slider(self, name: str, _event) -> None:
+        if not self._syncing:
+            self.set_joint(name, float(self.sliders[name].value))  # type: ignore[attr-defined]
+
+    def set_joint(self, name: str, value: float) -> None:
+        """Move one joint of the first robot (as its slider does); the gizmo goes to the new TCP."""
+        with self.lock:
+            self.robots[0].q[name] = float(value)
+            self.refresh()
+            T = self.frames[0].triads[2].pose
+            self.target.position, self.target.wxyz = tuple(T[:3, 3]), wxyz(T[:3, :3])
+
+    def follow_target(self) -> None:
+        """IK of the first arm to the gizmo's pose (TCP), seeded at the current joints."""
+        from robocfg.kinematics.model import KinematicModel
+
+        with self.lock:
+            first = self.robots[0]
+            arm = first.checked.config.arms[0]
+            if self._model is None:
+                self._model = KinematicModel.from_robot(first.checked, base_pose=first.mount)
+            w, x, y, z = self.target.wxyz
+            T = pose_to_matrix(self.target.position, (x, y, z, w))
+            joints = first.checked.arm_joints(arm)
+            seed = np.array([first.q[j] for j in joints])
+            res = self._model.ik(T, seed_q=seed, time_budget=0.05)
+            first.q.update(zip(joints, res.q.tolist(), strict=True))
+            self.refresh()
+            self.ik_status = ("converged" if res.converged else "not reachable, closest shown") + \
+                f" (residual {res.pos_err * 1000:.1f} mm, {np.degrees(res.rot_err):.1f}°)"
+            self._ik_text.content = f"IK: {self.ik_status}"
+
+    def refresh(self) -> None:
+        """Send joint values, redraw the frames, move the sliders to the joint values."""
+        with self.lock:
+            self.frames = []
+            for r in self.robots:
+                r.apply()
+                length = 0.08 if r.checked.config.arms[0].tcp_offset < 0.15 else 0.2
+                for arm in r.checked.config.arms:
+                    f = arm_frames(arm, r.link_pose, pad_boxes_ee(r.checked, arm), length)
+                    self.frames.append(f)
+                    self._draw(f, f"{r.node}_frames/{arm.name}")
+            self._syncing = True
+            try:
+                for name, s in self.sliders.items():
+                    v = self.robots[0].q.get(name, 0.0)
+                    if abs(s.value - v) > 1e-9:  # type: ignore[attr-defined]
+                        s.value = v  # type: ignore[attr-defined]
+            finally:
+                self._syncing = False
+
+    def _draw(self, f: ArmFrames, node: str) -> None:
+        scene = self.server.scene
+        for k, tri in enumerate(f.triads):
+            name = f"{node}/triad{k}"
+            scene.add_frame(name, axes_length=tri.length, axes_radius=tri.length * 0.05,
+                            position=tuple(tri.pose[:3, 3]), wxyz=wxyz(tri.pose[:3, :3]))
+            scene.add_label(f"{name}/label", tri.label, anchor=LABEL_ANCHORS[k])
+        seg = np.array([[f.ee_axis.start, f.ee_axis.end]])
+        scene.add_line_segments(f"{node}/ee_axis", seg, (200, 0, 200), thickness=4.0, thickness_units="screen")
+        if f.pads:
+            pads = np.array([[pad.corners[i], pad.corners[j]] for pad in f.pads for i, j in BOX_EDGES])
+            scene.add_line_segments(f"{node}/pads", pads, (255, 140, 0), thickness=3.0, thickness_units="screen")
+
+    def scene_names(self) -> list[str]:
+        """Names of the scene nodes the server holds (robot links, frames, scenery)."""
+        return sorted(self.server.scene._handle_from_node_name)  # viser keeps no public listing
+
+    def stop(self) -> None:
+        self.server.stop()

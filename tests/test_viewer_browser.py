@@ -1,0 +1,142 @@
+"""The browser viewer for real: a viser server on a free port, opened in headless Chromium
+(Debian's ``chromium``, driven by playwright; ``.ci/run`` installs it), a slider moved from the
+page, the gizmo followed by IK, and a YAML saved broken and fixed again."""
+
+import shutil
+import socket
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from robocfg.config import catalog
+from robocfg.viewer.browser import BrowserViewer
+from robocfg.viewer.server import watch
+from robocfg.viewer.source import ViewSource, find_source
+
+CHROMIUM = Path("/usr/bin/chromium")
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _wait(cond, timeout: float = 20.0, what: str = "condition") -> None:
+    end = time.monotonic() + timeout
+    while not cond():
+        if time.monotonic() > end:
+            raise AssertionError(f"timed out waiting for {what}")
+        time.sleep(0.1)
+
+
+def _scene_pixels(page) -> np.ndarray:
+    """Grey pixels of the 3-D view left of the control panel (the page's screenshot)."""
+    from io import BytesIO
+
+    from PIL import Image
+
+    img = Image.open(BytesIO(page.screenshot(clip={"x": 0, "y": 160, "width": 900, "height": 600})))
+    return np.asarray(img.convert("L"), dtype=float)
+
+
+@pytest.fixture
+def viewer():
+    v = BrowserViewer(find_source("panda"), port=_free_port())
+    yield v
+    v.stop()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    if not CHROMIUM.exists():
+        pytest.skip("Debian's chromium is not installed (/usr/bin/chromium); .ci/run installs it")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=str(CHROMIUM), args=["--use-gl=swiftshader", "--enable-unsafe-swiftshader"])
+        yield b
+        b.close()
+
+
+def test_viewer_binds_localhost_and_holds_robot_and_frames(viewer):
+    assert viewer.server.get_host() == "127.0.0.1"
+    names = viewer.scene_names()
+    assert any(n.endswith("/panda_hand") for n in names), "robot links are scene nodes"
+    assert any(n.endswith("/collision") for n in names), "collision meshes are loaded (hidden until toggled)"
+    labels = [n for n in names if n.endswith("/label")]
+    assert len(labels) == 4  # base, ee_link, TCP, grasp
+    assert "/target" in names
+
+
+def test_gizmo_moves_the_arm_by_ik(viewer):
+    target = np.array([0.45, 0.15, 0.35])
+    viewer.target.position = tuple(target)
+    viewer.follow_target()
+    assert viewer.ik_status.startswith("converged")
+    tcp = viewer.frames[0].tcp()
+    assert np.linalg.norm(tcp - target) < 1e-3
+    # the drawn TCP comes from the URDF FK of the joint values IK returned, not from the gizmo
+    arm = viewer.robots[0]
+    assert np.allclose(arm.link_pose("panda_hand")[:3, 3], viewer.frames[0].ee_axis.start)
+
+
+def test_page_shows_robot_and_slider_moves_a_link(viewer, browser):
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    try:
+        page.goto(viewer.url)
+        _wait(lambda: len(viewer.server.get_clients()) == 1, what="the page to connect")
+        page.wait_for_selector("canvas", timeout=20000)
+        page.get_by_text("panda_joint1").first.wait_for(timeout=20000)  # the sliders arrived
+        time.sleep(2.0)  # let the client load the meshes and draw
+        before = _scene_pixels(page)
+        assert before.std() > 10, "the 3-D view shows something"
+        hand0 = viewer.robots[0].link_pose("panda_hand")[:3, 3].copy()
+        slider = page.get_by_role("slider").first  # panda_joint1
+        slider.focus()
+        page.keyboard.press("End")
+        upper = viewer.sliders["panda_joint1"].max
+        _wait(lambda: abs(viewer.robots[0].q["panda_joint1"] - upper) < 1e-6, what="the slider update")
+        hand1 = viewer.robots[0].link_pose("panda_hand")[:3, 3]
+        assert np.linalg.norm(hand1 - hand0) > 0.1
+        assert np.isclose(np.linalg.norm(hand1[:2]), np.linalg.norm(hand0[:2]))  # a turn about the base z axis
+        _wait(lambda: np.abs(_scene_pixels(page).astype(int) - before).mean() > 0.5, what="the page to redraw")
+        for close in page.locator("button.mantine-Notification-closeButton").all():
+            close.click()
+        time.sleep(1.5)  # the notification fades out, the labels settle
+        page.screenshot(path=str(DOCS / "viewer-panda.png"))
+    finally:
+        page.close()
+
+
+def test_saving_a_broken_yaml_shows_its_errors_in_the_page(tmp_path, browser):
+    src = catalog.find("robots", "panda")
+    path = tmp_path / "my_panda.yaml"
+    shutil.copy(src, path)
+    v = BrowserViewer(ViewSource("robot", path), port=_free_port())
+    stop = threading.Event()
+    watcher = threading.Thread(target=watch, args=(v, 0.05, stop.is_set), daemon=True)
+    watcher.start()
+    page = browser.new_page()
+    try:
+        page.goto(v.url)
+        _wait(lambda: len(v.server.get_clients()) == 1, what="the page to connect")
+        text = path.read_text()
+        path.write_text(text.replace("ee_link: panda_hand", "ee_link: panda_hnd"))
+        _wait(lambda: bool(v.errors), what="the reload with errors")
+        line = next(i for i, s in enumerate(text.splitlines(), 1) if "ee_link: panda_hand" in s)
+        assert v.errors[0].startswith(f"{path}:{line}:")
+        assert "did you mean 'panda_hand'" in v.errors[0]
+        page.get_by_text("is invalid").first.wait_for(timeout=20000)
+        assert page.get_by_text("panda_hnd").count() >= 1
+        path.write_text(text)
+        _wait(lambda: not v.errors and v.robots, what="the reload after the fix")
+    finally:
+        stop.set()
+        watcher.join(5)
+        page.close()
+        v.stop()
