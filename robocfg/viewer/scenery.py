@@ -37,7 +37,7 @@ def body_mesh(body: Body, base_dir) -> trimesh.Trimesh | None:
 
 def _colored(mesh: trimesh.Trimesh, rgba) -> trimesh.Trimesh:
     c = np.asarray(rgba, float)
-    mesh.visual.face_colors = np.clip(np.round((c if c.max() > 1 else c * 255)), 0, 255).astype(np.uint8)
+    mesh.visual.face_colors = np.clip(np.round(c if c.max() > 1 else c * 255), 0, 255).astype(np.uint8)
     return mesh
 
 
