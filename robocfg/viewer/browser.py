@@ -23,7 +23,8 @@ import numpy as np
 
 from robocfg.checks import CheckedRobot
 from robocfg.errors import ConfigError
-from robocfg.sim.frames import matrix_to_quat, pose_matrix, pose_to_matrix
+from robocfg.geometry.pose import pose_matrix, pose_to_matrix
+from robocfg.geometry.rotation import matrix_to_quat
 from robocfg.viewer.frames import BOX_EDGES, ArmFrames, arm_frames, pad_boxes_ee
 from robocfg.viewer.scenery import add_scenery
 from robocfg.viewer.source import ViewSource

@@ -9,7 +9,7 @@ import trimesh
 
 from robocfg.checks import CheckedTask
 from robocfg.config.scene import Body
-from robocfg.sim.frames import pose_matrix
+from robocfg.geometry.pose import pose_matrix
 
 PLACE_COLOR = (40, 200, 60, 110)
 
