@@ -72,3 +72,14 @@ def test_pose_round_trip_and_config_pose():
     pos, quat = matrix_to_pose(T)
     assert np.allclose(pose_to_matrix(pos, quat), T, atol=1e-12)
     assert np.allclose(pose_matrix(Pose(position=[0.1, -0.2, 0.3], euler_deg=[10.0, 20.0, 30.0])), T, atol=1e-12)
+
+
+def test_closed_forms_match_scipy():
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(2)
+    for rpy in rng.uniform(-np.pi, np.pi, size=(30, 3)):
+        assert np.allclose(rpy_matrix(*rpy), Rotation.from_euler("xyz", rpy).as_matrix(), atol=1e-12)
+    for axis, angle in zip(rng.normal(size=(30, 3)), rng.uniform(-4, 4, 30), strict=True):
+        ref = Rotation.from_rotvec(axis / np.linalg.norm(axis) * angle).as_matrix()
+        assert np.allclose(axis_angle_matrix(axis, angle), ref, atol=1e-12)

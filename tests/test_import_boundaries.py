@@ -1,6 +1,6 @@
 """Importing the planning layers does not start the simulator: the grasp planner, the IK
-benchmark protocol and the collision geometry load without pybullet, and config models load
-without scipy (so `robocfg validate` stays fast)."""
+benchmark protocol and the collision geometry load without pybullet, and config models and the
+URDF parser load without scipy (so `robocfg validate` stays fast)."""
 
 from __future__ import annotations
 
@@ -22,6 +22,7 @@ def test_planners_do_not_load_pybullet() -> None:
     assert _loaded_after(["robocfg.sim.link_boxes"], ["pybullet"]) == ["pybullet"]  # the probe can fail
 
 
-def test_config_models_do_not_load_scipy_or_simulators() -> None:
-    mods = ["robocfg.config.robot", "robocfg.config.task", "robocfg.config.types"]
+def test_config_and_urdf_parsing_do_not_load_scipy_or_simulators() -> None:
+    mods = ["robocfg.config.robot", "robocfg.config.task", "robocfg.config.types", "robocfg.assets.urdf",
+            "robocfg.geometry"]
     assert _loaded_after(mods, ["scipy", "pybullet", "pinocchio", "placo"]) == []
