@@ -88,6 +88,17 @@ def test_lerobot_layout_dtypes_and_index_ranges(lerobot_ds):
     act = np.asarray(data["action"].to_pylist())[:, :7]
     state = np.asarray(data["observation.state"].to_pylist())[:, :7]
     assert np.max(np.abs(act[eps[0]["length"] - 1] - state[eps[0]["length"] - 1])) < 0.02
+    # the TCP (base frame = world here) sits on the cube while grasping; quaternions are unit
+    names = json.loads((root / "meta/info.json").read_text())["features"]["observation.state"]["names"]
+    full = np.asarray(data["observation.state"].to_pylist())
+    tcp = full[:, names.index("tcp.x"):names.index("tcp.z") + 1]
+    quat = full[:, names.index("tcp.qx"):names.index("tcp.qw") + 1]
+    obj = np.asarray(data["observation.environment_state"].to_pylist())
+    grasping = data["phase_index"].to_numpy() == info["robocfg"]["phases"].index("grasp")
+    assert grasping.any()
+    assert np.max(np.linalg.norm(tcp[grasping] - obj[grasping, :3], axis=1)) < 0.02
+    np.testing.assert_allclose(np.linalg.norm(quat, axis=1), 1.0, atol=1e-5)
+    np.testing.assert_allclose(np.linalg.norm(obj[:, 3:], axis=1), 1.0, atol=1e-5)
     phases = data["phase_index"].to_numpy()
     assert set(info["robocfg"]["phases"][i] for i in np.unique(phases)) >= {"approach", "grasp", "transport", "retract"}
 

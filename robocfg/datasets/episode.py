@@ -5,8 +5,8 @@ state the episode starts in). Per frame:
 
 * ``state`` (robot, base frame): arm joint positions (rad), gripper joint positions (rad or m),
   arm joint velocities, gripper joint velocities, TCP position (m) and orientation (quaternion
-  x y z w) in the robot base frame, gripper opening (measured finger gap in m; for a gripper
-  without fingers, 1 = released, -1 = holding);
+  x y z w) in the robot base frame, gripper opening (measured opening fraction of the driven
+  finger joints, 0 = closed to 1 = open; a suction cup: 0 while on, 1 when off);
 * ``env_state``: the object's position (m) and orientation (quaternion x y z w) in the robot base
   frame;
 * ``action``: the arm joint position targets (rad) that the drives reach at frame k + 1 (the

@@ -60,6 +60,9 @@ class CommandGate:
         values exactly representable in float32)."""
         a = self._round(np.append(self.q_wanted, self.g_wanted) if action is None else np.asarray(action))
         self._prev, self._cur = (a if first else self._cur), a
+        self._delta = a[:-1] - self._prev[:-1]
+        self._slope = self._delta / (self.steps_per_frame * self.world.dt)
+        self._moving = bool(np.any(self._delta))
         g = float(a[-1])
         real = self._real_open if g > 0 else self._real_close
         if g != self._g_applied and real is not None:
@@ -69,9 +72,10 @@ class CommandGate:
 
     def drive(self, j: int) -> None:
         """Send the arm targets for physics step ``j`` (1..steps_per_frame) of the current interval."""
-        n = self.steps_per_frame
-        d = self._cur[:-1] - self._prev[:-1]
-        self._real_command(self._prev[:-1] + (min(j, n) / n) * d, d / (n * self.world.dt))
+        if j > 1 and not self._moving:  # a held target is sent once per interval, not every step
+            return
+        s = min(j, self.steps_per_frame) / self.steps_per_frame
+        self._real_command(self._prev[:-1] + s * self._delta, self._slope)
 
     @staticmethod
     def _round(a: np.ndarray) -> np.ndarray:

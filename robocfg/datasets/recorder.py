@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from robocfg.config.types import AXIS_INDEX
 from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
 from robocfg.datasets.gate import CommandGate
 from robocfg.errors import RobocfgError
@@ -47,11 +48,14 @@ class EpisodeRecorder:
         self.n = steps_per_frame(world.dt, layout.fps)
         self.gate = CommandGate(world, arm, self.n)
         self.replay_actions = replay_actions
-        self._grip_joints = list(arm.robot.checked.gripper_joints(arm.config)) if arm.gripper is not None else []
+        grip = list(arm.robot.checked.gripper_joints(arm.config)) if arm.gripper is not None else []
+        self._joint_names = list(arm.joints) + grip
         self._base_inv = np.linalg.inv(world.robot.base_pose())
         self._phase_index = {p: i for i, p in enumerate(layout.phases)}
-        self.state: list[np.ndarray] = []
-        self.env: list[np.ndarray] = []
+        self.joints: list[np.ndarray] = []  # positions then velocities
+        self.opening: list[float] = []
+        self.T_ee: list[np.ndarray] = []  # ee_link world position + quaternion x y z w per frame
+        self.obj_pose: list[np.ndarray] = []  # world position + quaternion x y z w per frame
         self.actions: list[np.ndarray] = []
         self.phases: list[int] = []
         self.images: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras}
@@ -79,8 +83,12 @@ class EpisodeRecorder:
         else:
             a = self.gate.latch(first=first)
         self.actions.append(a)
-        self.state.append(self._state())
-        self.env.append(self._pose_in_base(*self.world.body_pose(self.obj)))
+        r, arm, names = self.arm.robot, self.arm, self._joint_names
+        self.joints.append(np.concatenate([r.joint_positions(names), r.joint_velocities(names)]))
+        self.opening.append(arm.gripper.fraction() if arm.gripper is not None else 0.0)
+        pos, quat = r.link_position_quat(arm.config.ee_link)
+        self.T_ee.append(np.concatenate([pos, quat]))
+        self.obj_pose.append(np.concatenate(self.world.body_pose(self.obj)))
         self.phases.append(self._phase_index.get(self.phase_of(), 0))
         if self.rig is not None and self.layout.cameras:
             for name, img in self.rig.render_all().items():
@@ -88,30 +96,34 @@ class EpisodeRecorder:
                 if img.depth is not None:
                     self.depth[name].append(img.depth)
 
-    def _state(self) -> np.ndarray:
-        r, arm = self.arm.robot, self.arm
-        names = list(arm.joints) + self._grip_joints
-        T = self._base_inv @ arm.tcp_pose()
-        g = arm.gripper
-        opening = g.width() if hasattr(g, "width") else (g.state() if g is not None else 0.0)
-        return np.concatenate([r.joint_positions(names), r.joint_velocities(names), T[:3, 3],
-                               Rotation.from_matrix(T[:3, :3]).as_quat(), [opening]])
-
-    def _pose_in_base(self, pos, quat_xyzw) -> np.ndarray:
-        R = self._base_inv[:3, :3]
-        p = R @ np.asarray(pos) + self._base_inv[:3, 3]
-        q = (Rotation.from_matrix(R) * Rotation.from_quat(quat_xyzw)).as_quat()
-        return np.concatenate([p, q])
+    def _in_base(self) -> tuple[np.ndarray, np.ndarray]:
+        """(T, 7) TCP and (T, 7) object poses in the robot base frame (position m, quaternion
+        x y z w), converted for all frames at once."""
+        Tb = self._base_inv
+        T_off = np.eye(4)
+        T_off[AXIS_INDEX[self.arm.config.ee_axis], 3] = self.arm.config.tcp_offset
+        ee = np.asarray(self.T_ee).reshape(-1, 7)
+        T_ee = np.tile(np.eye(4), (len(ee), 1, 1))
+        T_ee[:, :3, :3], T_ee[:, :3, 3] = Rotation.from_quat(ee[:, 3:]).as_matrix(), ee[:, :3]
+        T_tcp = Tb @ T_ee @ T_off
+        tcp = np.concatenate([T_tcp[:, :3, 3], Rotation.from_matrix(T_tcp[:, :3, :3]).as_quat()], axis=1)
+        obj = np.asarray(self.obj_pose).reshape(-1, 7)
+        pos = obj[:, :3] @ Tb[:3, :3].T + Tb[:3, 3]
+        quat = (Rotation.from_matrix(Tb[:3, :3]) * Rotation.from_quat(obj[:, 3:])).as_quat()
+        return tcp, np.concatenate([pos, quat], axis=1)
 
     def finish(self, index: int, seed: int, language: str, success: bool, failed_phase: str | None,
                reason: str) -> EpisodeRecord:
         """The episode's record (the gate is removed)."""
         self.stop()
         pos, quat = self.world.body_pose(self.obj)
+        tcp, env = self._in_base()
+        state = np.concatenate([np.asarray(self.joints).reshape(len(tcp), -1), tcp,
+                                np.asarray(self.opening)[:, None]], axis=1)
         return EpisodeRecord(
             index=index, seed=seed, language=language, success=success, failed_phase=failed_phase,
             reason=reason, physics_steps=self.world.steps, object_final=[*map(float, pos), *map(float, quat)],
-            state=np.asarray(self.state, np.float32), env_state=np.asarray(self.env, np.float32),
+            state=state.astype(np.float32), env_state=env.astype(np.float32),
             action=np.asarray(self.actions, np.float32), phase=np.asarray(self.phases, np.int64),
             images={k: np.asarray(v, np.uint8) for k, v in self.images.items()},
             depth={k: np.asarray(v, np.float32) for k, v in self.depth.items()},

@@ -221,6 +221,18 @@ class RobotHandle:
         s = p.getLinkState(self.body_id, i, computeForwardKinematics=True, physicsClientId=self.client)
         return pose_to_matrix(s[4], s[5])
 
+    def link_position_quat(self, link: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(position m, quaternion x y z w) of the URDF frame of ``link`` in the world, as PyBullet
+        gives them: no matrix built, for per-frame sampling (the root link: its base pose)."""
+        i = self.link(link)
+        if i == -1:
+            from robocfg.geometry.pose import matrix_to_pose
+
+            pos, quat = matrix_to_pose(self.base_pose())
+            return tuple(pos), tuple(quat)
+        s = p.getLinkState(self.body_id, i, computeForwardKinematics=True, physicsClientId=self.client)
+        return s[4], s[5]
+
     def base_pose(self) -> np.ndarray:
         """4x4 world pose of the root link's URDF frame."""
         pos, orn = p.getBasePositionAndOrientation(self.body_id, physicsClientId=self.client)

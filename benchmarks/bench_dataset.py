@@ -1,0 +1,122 @@
+"""Dataset recording cost: successful pick-place demos per core-minute without a dataset, with a
+state-only dataset and with two 128x128 cameras (20 Hz); camera frames/s per renderer option;
+size on disk and pyarrow load time of a larger state-only dataset.
+
+    python benchmarks/bench_dataset.py --episodes 20 --camera-episodes 4 --size-episodes 1000 [--json out.json]
+
+One process, one core: "per core-minute" = successes / (wall minutes of the run). The state-only
+ratio (dataset / none) is the cost of sampling, the command gate and writing (goal ≤ 1.1×).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+
+def _task(name: str, cameras: bool, size: int = 128):
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+
+    t = load_task(catalog.find("tasks", name))
+    cams = [c.model_copy(update={"width": size, "height": size}) for c in t.config.cameras] if cameras else []
+    return dataclasses.replace(t, config=t.config.model_copy(update={"cameras": cams}))
+
+
+def _run(task, episodes: int, seed: int, fmt: str | None, out: Path) -> dict:
+    from robocfg.datasets.language import pick_place_instruction
+    from robocfg.datasets.sink import DatasetSink
+    from robocfg.runners.pick_place import run_pick_place
+
+    sink = None
+    if fmt is not None:
+        shutil.rmtree(out, ignore_errors=True)
+        sink = DatasetSink(out, fmt, task, language=pick_place_instruction(task.config.pick_place),
+                           extra_info={"task_path": str(task.path), "seed": seed, "arm": None, "robot_override": None})
+    t0 = time.perf_counter()
+    report, _ = run_pick_place(task, episodes, seed, sink=sink)
+    if sink is not None:
+        sink.close()
+    wall = time.perf_counter() - t0
+    ok = report.summary.successes
+    return {"episodes": episodes, "successes": ok, "wall_s": round(wall, 2),
+            "demos_per_core_minute": round(ok / (wall / 60.0), 1)}
+
+
+def _render_rate(size: int, renderer: str, frames: int = 30) -> float:
+    """Frames/s of rendering both task cameras once per frame (a frame = scene + wrist image)."""
+    from robocfg.sim.camera_rig import CameraRig
+    from robocfg.sim.world import World
+
+    task = _task("pick_place", True, size)
+    with World(task) as world:
+        world.add_body(task.config.pick_place.object)
+        rig = CameraRig(world, world.robot.arm(), task.config.cameras, renderer)  # type: ignore[arg-type]
+        rig.render_all()
+        t0 = time.perf_counter()
+        for _ in range(frames):
+            rig.render_all()
+        return frames / (time.perf_counter() - t0)
+
+
+def _dir_size(root: Path) -> int:
+    return sum(f.stat().st_size for f in root.rglob("*") if f.is_file())
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--episodes", type=int, default=20, help="state-only rows")
+    ap.add_argument("--camera-episodes", type=int, default=4, help="two-camera row")
+    ap.add_argument("--size-episodes", type=int, default=1000, help="size-on-disk row (0: skip)")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--renderers", default="tiny,egl")
+    ap.add_argument("--json", default=None)
+    args = ap.parse_args()
+
+    from robocfg.sim.quiet import quiet_import
+
+    quiet_import()
+    import pyarrow.parquet as pq
+
+    tmp = Path(tempfile.mkdtemp(prefix="bench_dataset_"))
+    state, cams = _task("pick_place", False), _task("pick_place", True)
+    _run(state, 1, args.seed, None, tmp / "warm")  # imports and caches out of the timings
+    res: dict = {"rows": {}}
+    res["rows"]["no dataset"] = _run(state, args.episodes, args.seed, None, tmp / "none")
+    res["rows"]["state-only lerobot"] = _run(state, args.episodes, args.seed, "lerobot", tmp / "state_lr")
+    res["rows"]["state-only hdf5"] = _run(state, args.episodes, args.seed, "hdf5", tmp / "state_h5")
+    res["rows"]["2 cameras 128x128 lerobot"] = _run(cams, args.camera_episodes, args.seed, "lerobot", tmp / "cams")
+    base = res["rows"]["no dataset"]["wall_s"] / args.episodes
+    for k in ("state-only lerobot", "state-only hdf5"):
+        res["rows"][k]["cost_vs_none"] = round(res["rows"][k]["wall_s"] / args.episodes / base, 3)
+    res["rows"]["2 cameras 128x128 lerobot"]["cost_vs_none"] = round(
+        res["rows"]["2 cameras 128x128 lerobot"]["wall_s"] / args.camera_episodes / base, 3)
+    res["render_frames_per_s"] = {}
+    for r in args.renderers.split(","):
+        for size in (64, 128, 256):
+            try:
+                res["render_frames_per_s"][f"{r} {size}x{size} x2 cameras"] = round(_render_rate(size, r), 1)
+            except Exception as exc:  # a renderer this machine lacks is reported, not fatal
+                res["render_frames_per_s"][f"{r} {size}x{size} x2 cameras"] = f"unavailable: {exc}"
+                break
+    if args.size_episodes:
+        root = tmp / "size"
+        row = _run(state, args.size_episodes, args.seed, "lerobot", root)
+        t0 = time.perf_counter()
+        table = pq.read_table(root / "data/chunk-000/file-000.parquet")
+        load = time.perf_counter() - t0
+        row |= {"bytes_on_disk": _dir_size(root), "frames": table.num_rows, "pyarrow_load_s": round(load, 4)}
+        res["size"] = row
+    shutil.rmtree(tmp, ignore_errors=True)
+    print(json.dumps(res, indent=2))
+    if args.json:
+        Path(args.json).write_text(json.dumps(res, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
