@@ -183,3 +183,24 @@ def test_cli_dataset_info_and_errors(lerobot_ds, tmp_path, capsys, monkeypatch):
     assert code == 2 and "does not divide" in err
     code, _, err = run_main(["dataset", "replay", str(root), "--episode", "5"], capsys, monkeypatch)
     assert code == 2 and "has 2 episode(s)" in err
+
+
+def test_keep_success_drops_failures_and_keep_all_labels_them(tmp_path, capsys, monkeypatch):
+    doc = yaml.safe_load((ROOT / "tasks/pick_place.yaml").read_text())
+    doc.pop("cameras")
+    doc["pick_place"]["timeouts"] = {"lift": 0.1}  # the lift move needs longer: the episode fails there
+    task = tmp_path / "failing_lift.yaml"
+    task.write_text(yaml.safe_dump(doc))
+    code, _, _ = run_main(["run", "pick-place", str(task), "--dataset", str(tmp_path / "ok_only"), "-q"], capsys, monkeypatch)
+    assert code == 1
+    info = json.loads((tmp_path / "ok_only/meta/info.json").read_text())
+    assert info["total_episodes"] == 0 and info["total_frames"] == 0
+    code, _, _ = run_main(["run", "pick-place", str(task), "--dataset", str(tmp_path / "all"), "--keep", "all",
+                           "--dataset-format", "hdf5", "-q"], capsys, monkeypatch)
+    assert code == 1
+    with h5py.File(tmp_path / "all/data.hdf5", "r") as f:
+        a = f["data/demo_0"].attrs
+        assert not a["success"] and a["failed_phase"] == "lift" and "timeout" in a["reason"]
+        assert f["data/demo_0/rewards"][-1] == 0.0
+    code, out, _ = run_main(["dataset", "replay", str(tmp_path / "all"), "--episode", "0"], capsys, monkeypatch)
+    assert code == 0 and "False / False" in out and "matches" in out
