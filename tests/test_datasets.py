@@ -14,13 +14,13 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 import yaml
+from _cli import ROOT, run_main
 
 from robocfg.checks import load_task
 from robocfg.datasets.language import pick_place_instruction
 from robocfg.datasets.replay import replay_episode
 from robocfg.datasets.sink import DatasetSink
 from robocfg.runners.pick_place import run_pick_place
-from _cli import ROOT, run_main
 
 FPS = 10  # divides the 240 Hz physics rate; fewer rendered frames keep the test quick
 
