@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import copy
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from pydantic import TypeAdapter
@@ -11,6 +14,7 @@ from pydantic import TypeAdapter
 from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
+from robocfg.config.overrides import apply_overrides, blame_overrides
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.task import PickPlaceTask, TaskConfig
 from robocfg.errors import ConfigError, NotFound, Problem
@@ -36,10 +40,33 @@ class CheckedTask:
     def path(self) -> Path:
         return self.doc.path
 
+    def with_overrides(self, overrides: Mapping[str, Any], strict: bool = False) -> CheckedTask:
+        """A re-validated copy with dotted keys set (``{"pick_place.lift_height": 0.2}``); the
+        same checks as loading the file, problems inside an override named after its key."""
+        return check_task_document(self.doc, strict=strict, overrides=overrides)
 
-def load_task(path: str | Path, strict: bool = False, robot_override: str | None = None) -> CheckedTask:
-    """Load and check a task YAML. ``robot_override`` replaces the first robot (``--robot NAME``)."""
-    doc = load_yaml(path)
+
+def load_task(path: str | Path, strict: bool = False, robot_override: str | None = None,
+              overrides: Mapping[str, Any] | None = None) -> CheckedTask:
+    """Load and check a task YAML. ``robot_override`` replaces the first robot (``--robot NAME``);
+    ``overrides`` sets dotted keys before validation (see ``robocfg.config.overrides``)."""
+    return check_task_document(load_yaml(path), strict, robot_override, overrides)
+
+
+def check_task_document(doc: YamlDocument, strict: bool = False, robot_override: str | None = None,
+                        overrides: Mapping[str, Any] | None = None) -> CheckedTask:
+    """Validate a loaded task document and load and check the robots it names."""
+    if overrides:
+        doc = apply_overrides(doc, overrides)
+    elif robot_override is not None:
+        doc = YamlDocument(doc.path, copy.deepcopy(doc.data), doc.marks)
+    try:
+        return _check_document(doc, strict, robot_override)
+    except ConfigError as exc:
+        raise blame_overrides(exc, overrides or {}) from None
+
+
+def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None) -> CheckedTask:
     if robot_override is not None and isinstance(doc.data.get("robots"), list) and doc.data["robots"]:
         first = dict(doc.data["robots"][0]) if isinstance(doc.data["robots"][0], dict) else {}
         first.pop("robot_config_file", None)

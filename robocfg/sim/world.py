@@ -223,6 +223,11 @@ class World:
         pos, orn = p.getBasePositionAndOrientation(self.body_id(name_or_id), physicsClientId=self.client)
         return np.asarray(pos), np.asarray(orn)
 
+    def body_velocity(self, name_or_id: str | int) -> tuple[np.ndarray, np.ndarray]:
+        """(linear (3,) m/s, angular (3,) rad/s) velocity of a body's base, world frame."""
+        lin, ang = p.getBaseVelocity(self.body_id(name_or_id), physicsClientId=self.client)
+        return np.asarray(lin), np.asarray(ang)
+
     def set_body_pose(self, name_or_id: str | int, position, quat_xyzw=(0.0, 0.0, 0.0, 1.0)) -> None:
         """Teleport a body (velocity zeroed)."""
         bid = self.body_id(name_or_id)
