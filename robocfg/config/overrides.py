@@ -14,8 +14,8 @@ from dataclasses import replace
 from typing import Any
 
 from robocfg.config.load import Loc, YamlDocument, format_loc
-from robocfg.config.suggest import did_you_mean
 from robocfg.errors import ConfigError, Problem
+from robocfg.suggest import did_you_mean
 
 OVERRIDE_SOURCE = "override"  # the "file" an override's problems are reported against
 
