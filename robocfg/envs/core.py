@@ -28,7 +28,9 @@ import numpy as np
 from gymnasium import spaces
 
 from robocfg import api
+from robocfg.geometry import rotation_angle
 from robocfg.kinematics.frames import top_down_grasps
+from robocfg.sim.gripper import ParallelGripper
 
 Control = Literal["ee", "joints"]
 RewardType = Literal["sparse", "dense"]
@@ -184,11 +186,8 @@ class RobotEnv(gym.Env):
         return {"is_success": d <= self.distance_threshold, "distance": d}
 
     def gripper_opening(self) -> float:
-        """Opening fraction of a parallel gripper (0 closed, 1 open); a suction cup: 1 off, 0 on."""
-        frac = getattr(self.gripper, "fraction", None)
-        if frac is not None:
-            return float(frac())
-        return 0.0 if self.gripper is not None and self.gripper.state() < 0 else 1.0
+        """Measured opening fraction (0 closed, 1 open; a suction cup: 0 while on); 1 without a gripper."""
+        return 1.0 if self.gripper is None else float(self.gripper.fraction())
 
     def _apply(self, a: np.ndarray) -> None:
         if self.control == "ee":
@@ -210,7 +209,7 @@ class RobotEnv(gym.Env):
     def _command_gripper(self, g: float) -> None:
         if self.gripper is None:
             return
-        if hasattr(self.gripper, "set_fraction"):
+        if isinstance(self.gripper, ParallelGripper):
             self.gripper.set_fraction((g + 1.0) / 2.0)
         elif g < 0:
             self.gripper.close()
@@ -219,8 +218,6 @@ class RobotEnv(gym.Env):
 
     def _top_down_rotation(self, home_tcp: np.ndarray) -> np.ndarray:
         """World rotation of ``ee_link`` for a top-down grasp, the one of the two closest to home."""
-        from robocfg.kinematics.frames import rotation_angle
-
         R_ee_g = np.asarray(self.arm.config.R_ee_graspnet, float)
         cands = [g.rotation @ R_ee_g for g in top_down_grasps(home_tcp[:3, 3], 0.0, (0.05, 0.05))]
         return min(cands, key=lambda R: rotation_angle(home_tcp[:3, :3], R))

@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from robocfg.sim.gripper import ParallelGripper
+
 if TYPE_CHECKING:
     from robocfg.envs.tasks import PickPlaceEnv
 
@@ -33,7 +35,8 @@ def pick_place_action(env: PickPlaceEnv) -> np.ndarray:
     tcp, goal = env.tcp(), env.goal
     cube = env.world.body_pose(env.object)[0]
     # grasp point: the cube's centre between fingers; its top face for a suction cup
-    grasp = cube + (0.0 if hasattr(env.gripper, "fraction") else env.object_half_height) * np.array([0, 0, 1.0])
+    fingers = isinstance(env.gripper, ParallelGripper)
+    grasp = cube + (0.0 if fingers else env.object_half_height) * np.array([0, 0, 1.0])
     held = env.gripper is not None and env.gripper.is_grasping(env.object) and np.linalg.norm(grasp - tcp) < 0.05
     if held:
         flat = np.linalg.norm(goal[:2] - cube[:2])
