@@ -12,6 +12,7 @@ from robocfg.cli import (
     dataset,
     ik,
     inspect_cmd,
+    interop,
     new_robot,
     robots,
     run,
@@ -57,6 +58,8 @@ app.command("schema")(schema.schema)
 app.add_typer(run.run_app, name="run")
 app.command("ik")(ik.ik)
 app.add_typer(bench.bench_app, name="bench")
+app.add_typer(interop.import_app, name="import")
+app.add_typer(interop.export_app, name="export")
 app.command("view")(view.view)
 app.add_typer(dataset.dataset_app, name="dataset")
 

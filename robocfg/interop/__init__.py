@@ -1,0 +1,1 @@
+"""Reading and writing other tools' robot configs (config level only: no simulator)."""
