@@ -18,7 +18,7 @@ from robocfg.interop.interndata_import import import_interndata
 from robocfg.interop.isaac_order import isaac_dof_order
 from tests._cli import run_main
 
-DATA = Path(__file__).resolve().parent / "data" / "interndata"
+DATA = Path(__file__).resolve().parent / "interndata"  # not in tests/data, which `validate` reads as robocfg YAMLs
 PANDA_THEIRS = DATA / "panda.yaml"
 BUILTINS = sorted(p.stem for p in (BUILTIN_DIR / "robots").glob("*.yaml"))
 
