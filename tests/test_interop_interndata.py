@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from _cli import run_main
 
 from robocfg.assets.paths import Resolver
 from robocfg.checks import CheckedRobot, load_robot
@@ -16,7 +17,6 @@ from robocfg.errors import ConfigError
 from robocfg.interop.interndata_export import export_interndata
 from robocfg.interop.interndata_import import import_interndata
 from robocfg.interop.isaac_order import isaac_dof_order
-from tests._cli import run_main
 
 DATA = Path(__file__).resolve().parent / "interndata"  # not in tests/data, which `validate` reads as robocfg YAMLs
 PANDA_THEIRS = DATA / "panda.yaml"
