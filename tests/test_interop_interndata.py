@@ -198,3 +198,26 @@ def test_doc_commands_run(tmp_path, capsys, monkeypatch):
         code, out, err = run_main(command.split(), capsys, monkeypatch, tmp_path)
         assert code == 0, (command, out, err)
     assert (tmp_path / "robots" / "panda_again.yaml").is_file()
+
+
+def test_keys_outside_their_template_are_dropped(tmp_path):
+    p, _ = _variant(tmp_path, "lift_home: []", "lift_home: []\nsim_camera_mount: head_link")
+    result = import_interndata(p, tmp_path / "out.yaml", "pybullet_data://franka_panda/panda.urdf")
+    assert "template" in dict(result.dropped)["sim_camera_mount"]
+
+
+@pytest.mark.parametrize(("index", "owner"), [(0, "a left arm joint"), (7, "a left gripper joint")])
+def test_lift_joints_must_be_outside_the_arms(tmp_path, index, owner):
+    p, line = _variant(tmp_path, "lift_indices: []", f"lift_indices: [{index}]\n")
+    errors = _errors(p, tmp_path)
+    assert any(e.startswith(f"{p}:{line}:") and "lift_indices[0]" in e and owner in e for e in errors), errors
+
+
+def test_block_needs_one_entry_per_arm(tmp_path):
+    _, theirs = _export("dual_panda", tmp_path)
+    data = yaml.safe_load(theirs.read_text())
+    data["robocfg"]["arms"] = data["robocfg"]["arms"][:1]
+    theirs.write_text(yaml.safe_dump(data, sort_keys=False))
+    with pytest.raises(ConfigError) as exc:
+        import_interndata(theirs, tmp_path / "ours.yaml")
+    assert "one entry per arm (2: left, right)" in str(exc.value)

@@ -31,6 +31,7 @@ from robocfg.interop.isaac_order import isaac_dof_order
 SHARED = ("tcp_offset", "ee_axis", "R_ee_graspnet")
 NATIVE_ARM = ("joints", "joint_indices", "base_link", "ee_link", "home", "home_std", "collision_filter", "gripper_keypoints")
 NATIVE_GRIPPER = ("joints", "gripper_indices", "open")
+SUCTION_SIDE_MARK = 0.02  # m: where a derived tool_side is drawn for a cup, which has no jaw width
 
 
 @dataclass
@@ -94,13 +95,14 @@ def export_interndata(robot: CheckedRobot, output: Path) -> Exported:
 
 def _keypoints(arm: ArmConfig) -> dict[str, list[float]]:
     """Their homogeneous keypoints; without ours: head at the TCP, tail at the EE origin, side half a
-    jaw opening along the closing axis (grasp y in the EE frame is row 1 of R_ee_graspnet)."""
+    jaw opening (a suction cup: ``SUCTION_SIDE_MARK``) along the closing axis, which in the EE frame
+    is row 1 of R_ee_graspnet (grasp y)."""
     if arm.gripper_keypoints is not None:
         kp = arm.gripper_keypoints
         return {k: [*getattr(kp, k), 1] for k in ("tool_head", "tool_tail", "tool_side")}
     head = np.zeros(3)
     head[AXIS_INDEX[arm.ee_axis]] = arm.tcp_offset
-    half = arm.gripper.max_width / 2 if isinstance(arm.gripper, ParallelGripperConfig) else 0.02
+    half = arm.gripper.max_width / 2 if isinstance(arm.gripper, ParallelGripperConfig) else SUCTION_SIDE_MARK
     side = head + half * np.asarray(arm.R_ee_graspnet, float)[1]
     return {"tool_head": [*map(float, head), 1], "tool_tail": [0.0, 0.0, 0.0, 1], "tool_side": [*map(float, side), 1]}
 

@@ -86,6 +86,9 @@ def import_interndata(their_path: Path, output: Path, urdf: str | None = None) -
         raise ConfigError([Problem(str(doc.path), None, None, "", "pass --urdf ROBOT.urdf: their file names a USD "
                                    f"(path: {their.path!r}), which robocfg cannot load; give the URDF it was made from")])
     mapped = map_interndata(doc, their, parsed)
+    if "arms" in block and (not isinstance(block["arms"], list) or len(block["arms"]) != len(mapped.robot["arms"])):
+        raise ConfigError([doc.problem((BLOCK_KEY, "arms"), f"needs one entry per arm ({len(mapped.robot['arms'])}: "
+                                       f"{', '.join(their.sides)}), in the order left, right")])
     robot = overlay({**robot, **mapped.robot}, block)
     notes = list(mapped.notes)
     _fill_grippers(robot, mapped, parsed, notes)

@@ -101,16 +101,17 @@ def map_interndata(doc: YamlDocument, their: InterndataRobot, urdf: Urdf) -> Map
     out = Mapped({"arms": [], "physics": {"solver_iterations": their.solver_position_iteration_count}})
     out.origin["physics.solver_iterations"] = (("solver_position_iteration_count",), False)
     dual = len(their.sides) == 2
-    arm_joint_names: set[str] = set()
+    taken: dict[str, str] = {}  # joint → the arm or gripper that drives it
     for i, side in enumerate(their.sides):
         arm = _map_arm(m, out, i, side, "arm" if not dual else side)
-        arm_joint_names |= set(arm.get("joints", []))
+        taken.update({j: f"a {side} arm joint" for j in arm.get("joints", [])})
+        taken.update({j: f"a {side} gripper joint" for j in out.leaders.get(i, [])})
         out.robot["arms"].append(arm)
     if their.lift_indices:
         names = m.joints("lift_indices", their.lift_indices) or []
         for k, jn in enumerate(names):
-            if jn in arm_joint_names:
-                m.error(("lift_indices", k), f"DOF index {their.lift_indices[k]} is {jn!r}, an arm joint")
+            if jn in taken:
+                m.error(("lift_indices", k), f"DOF index {their.lift_indices[k]} is {jn!r}, {taken[jn]}")
         out.dropped.append(("lift_indices / lift_home", f"robocfg has no lift joint group: {names} stay at their URDF "
                             "zero position (they are checked to exist and to be outside the arms)"))
     for key, why in (("target_class", "robocfg robots are data, not Python classes"),
