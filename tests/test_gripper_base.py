@@ -1,32 +1,39 @@
-"""The Gripper base is complete: every registered gripper implements the whole interface, so
-callers never probe with hasattr; a suction cup answers the finger questions as documented."""
+"""The Gripper base is complete: every registered gripper implements the whole interface (the
+registry refuses one that does not), so callers never probe with hasattr; a suction cup answers
+the finger questions as documented."""
 
 from __future__ import annotations
 
-import inspect
 from pathlib import Path
 
 import pytest
 from _sim_helpers import DATA, make_task
 
+from robocfg.errors import RobocfgError
 from robocfg.sim.gripper import base
-from robocfg.sim.gripper.registry import GRIPPERS
-
-REQUIRED = [name for name, fn in inspect.getmembers(base.Gripper, inspect.isfunction)
-            if "raise NotImplementedError" in inspect.getsource(fn)]
+from robocfg.sim.gripper.registry import GRIPPERS, register
 
 
 def test_base_declares_the_interface() -> None:
-    assert {"open", "close", "reset", "fraction", "state", "is_grasping"} <= set(REQUIRED)
+    assert set(base.Gripper.__abstractmethods__) == {"open", "close", "reset", "fraction", "state", "is_grasping"}
     for name in ("set_force", "width", "update"):
         assert callable(getattr(base.Gripper, name))
 
 
 @pytest.mark.parametrize("type_name", sorted(GRIPPERS))
 def test_every_gripper_implements_the_interface(type_name: str) -> None:
-    cls = GRIPPERS[type_name]
-    missing = [m for m in REQUIRED if getattr(cls, m) is getattr(base.Gripper, m)]
-    assert not missing, f"{cls.__name__} lacks {missing}"
+    assert not GRIPPERS[type_name].__abstractmethods__
+
+
+def test_registry_refuses_an_incomplete_gripper() -> None:
+    class HalfGripper(base.Gripper):
+        def open(self) -> None: ...
+
+        def close(self) -> None: ...
+
+    with pytest.raises(RobocfgError, match="does not implement fraction, is_grasping, reset, state"):
+        register("half-test")(HalfGripper)
+    assert "half-test" not in GRIPPERS
 
 
 def test_suction_answers_fraction_width_and_force(tmp_path: Path) -> None:

@@ -52,3 +52,53 @@ def test_reachable_query_converges_within_the_budget(model: KinematicModel, back
         solver.max_total_iter = None
     assert res.converged and res.iterations <= 400
     assert res.pos_err <= 1e-5
+
+
+def test_a_backend_added_as_the_architecture_recipe_says(model: KinematicModel) -> None:
+    """docs/architecture.md, "Add an IK backend": a class with name / clock / max_total_iter /
+    solve built on prepare, search and finish, registered by name, is used through model.ik."""
+    import math
+    from time import perf_counter
+
+    import pinocchio as pin
+
+    from robocfg.kinematics.ik import registry
+    from robocfg.kinematics.ik.common import finish, into_limits, prepare, search
+
+    class GaussNewton:
+        name = "gauss-newton-test"
+        clock = staticmethod(perf_counter)
+
+        def __init__(self, km: KinematicModel, max_total_iter: int | None = None):
+            self.km, self.max_total_iter = km, max_total_iter
+
+        def solve(self, target, seed_q, frame="tcp", time_budget=0.02, position_only=False, rng=None):
+            t0, km = perf_counter(), self.km
+            _, q0, fid, Mt = prepare(km, target, seed_q, frame)
+
+            def descend(q, deadline, cap):
+                n, s = (30 if cap is None else min(30, cap)), math.inf
+                for it in range(1, n + 1):
+                    pin.forwardKinematics(km.model, km.data, q)
+                    err = pin.log6(pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)).vector
+                    s = float(np.linalg.norm(err))
+                    if s < 1e-9:
+                        return True, it, s, q
+                    J = pin.computeFrameJacobian(km.model, km.data, q, fid, pin.LOCAL)
+                    q = into_limits(km, q + np.linalg.lstsq(J, err, rcond=None)[0])
+                return False, n, s, q
+
+            best, iters, restarts = search(km, descend, q0, self.clock() + time_budget, rng, self.clock,
+                                           self.max_total_iter)
+            return finish(km, self.name, best, Mt, fid, position_only, 1e-5, 1e-5, t0, iters, restarts)
+
+    registry.register(GaussNewton.name)(GaussNewton)
+    try:
+        assert GaussNewton.name in known_backends()
+        fresh = KinematicModel.from_robot(load_robot(PANDA))
+        fresh.solver(GaussNewton.name).max_total_iter = 200
+        target = fresh.fk(fresh.mid + 0.2, "ee")
+        res = fresh.ik(target, fresh.mid, frame="ee", backend=GaussNewton.name, time_budget=60.0)
+        assert res.converged and res.backend == GaussNewton.name and res.iterations <= 200
+    finally:
+        registry._REGISTRY.pop(GaussNewton.name, None)

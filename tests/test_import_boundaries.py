@@ -26,3 +26,19 @@ def test_config_and_urdf_parsing_do_not_load_scipy_or_simulators() -> None:
     mods = ["robocfg.config.robot", "robocfg.config.task", "robocfg.config.types", "robocfg.assets.urdf",
             "robocfg.geometry"]
     assert _loaded_after(mods, ["scipy", "pybullet", "pinocchio", "placo"]) == []
+
+
+def test_architecture_doc_lists_every_layer_of_the_contract() -> None:
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    contracts = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"]
+    layers = next(c["layers"] for c in contracts if c["type"] == "layers")
+    doc = (root / "docs" / "architecture.md").read_text()
+    rows = [line for line in doc.splitlines() if line.startswith("| ") and "`robocfg." in line]
+    for depth, layer in enumerate(reversed(layers)):
+        for package in (p.strip() for p in layer.split("|")):
+            row = next((r for r in rows if f"`{package}`" in r), None)
+            assert row is not None, f"docs/architecture.md does not list {package}"
+            assert row.startswith(f"| {depth} |"), f"{package} is in layer {depth} of the contract: {row}"

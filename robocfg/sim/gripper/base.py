@@ -7,6 +7,7 @@ metres; forces in N (or N·m for revolute drives). Commands are non-blocking: th
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING, ClassVar
 
 from robocfg.errors import RobocfgError
@@ -19,9 +20,10 @@ if TYPE_CHECKING:
 OPEN, CLOSED = 1.0, -1.0
 
 
-class Gripper:
-    """A gripper on one arm. Subclasses implement every method that raises NotImplementedError;
-    the others have a meaning for every gripper and are overridden where the gripper can do more."""
+class Gripper(ABC):
+    """A gripper on one arm. Subclasses implement every abstract method (the registry refuses a
+    class that does not); the others have a meaning for every gripper and are overridden where
+    the gripper can do more."""
 
     type_name: ClassVar[str] = ""
     grasps_at_surface: ClassVar[bool] = False  # True: holds an object by its surface (suction), not around it
@@ -34,23 +36,29 @@ class Gripper:
         self.config: GripperConfig = arm.config.gripper
         self.client = self.robot.client
 
-    def update(self) -> None:
+    def update(self) -> None:  # noqa: B027 (no-op by design: most grippers have nothing to advance)
         """Advance rate-limited targets, attach/detach... Called by the World after each step."""
 
+    @abstractmethod
     def open(self) -> None:
+        """Start opening (non-blocking)."""
         raise NotImplementedError
 
+    @abstractmethod
     def close(self) -> None:
+        """Start closing, or switch the grip on (non-blocking)."""
         raise NotImplementedError
 
+    @abstractmethod
     def reset(self, fraction: float = 1.0) -> None:
         """Teleport to an opening ``fraction`` (1 open, 0 closed) and hold there, without dynamics
         (between episodes, or to measure the gripper at several openings)."""
         raise NotImplementedError
 
-    def set_force(self, force: float) -> None:
+    def set_force(self, force: float) -> None:  # noqa: B027 (no-op by design for grippers without a force)
         """Cap the grip force (N, or N·m). Grippers without a force setting (suction) ignore it."""
 
+    @abstractmethod
     def fraction(self) -> float:
         """Measured opening, 0 (closed) to 1 (open)."""
         raise NotImplementedError
@@ -59,10 +67,12 @@ class Gripper:
         """Measured finger gap (m), or None for a gripper without fingers."""
         return None
 
+    @abstractmethod
     def state(self) -> float:
         """1.0 (open) or −1.0 (closed)."""
         raise NotImplementedError
 
+    @abstractmethod
     def is_grasping(self, body: int | str) -> bool:
         """True while ``body`` (a body id or a world body name) is held."""
         raise NotImplementedError

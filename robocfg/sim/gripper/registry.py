@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 from typing import TYPE_CHECKING
 
 from robocfg.errors import NotFound, RobocfgError
@@ -15,11 +16,15 @@ GRIPPERS: dict[str, type[Gripper]] = {}
 
 
 def register(type_name: str):
-    """Class decorator: ``@register("parallel")``. A second class for the same name is an error."""
+    """Class decorator: ``@register("parallel")``. A second class for the same name is an error, and
+    so is a class that leaves an abstract method of :class:`Gripper` unimplemented."""
 
     def deco(cls: type[Gripper]) -> type[Gripper]:
         if type_name in GRIPPERS and GRIPPERS[type_name] is not cls:
             raise RobocfgError(f"gripper type {type_name!r} is already registered by {GRIPPERS[type_name].__name__}")
+        if inspect.isabstract(cls):
+            missing = ", ".join(sorted(getattr(cls, "__abstractmethods__", ())))
+            raise RobocfgError(f"gripper class {cls.__name__} does not implement {missing}")
         GRIPPERS[type_name] = cls
         cls.type_name = type_name
         return cls
