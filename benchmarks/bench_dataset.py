@@ -74,7 +74,7 @@ def main() -> None:
     ap.add_argument("--camera-episodes", type=int, default=4, help="two-camera row")
     ap.add_argument("--size-episodes", type=int, default=1000, help="size-on-disk row (0: skip)")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--renderers", default="tiny,egl")
+    ap.add_argument("--renderers", default="tiny")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
 

@@ -2,8 +2,7 @@
 
 A ``world`` camera is fixed; an ``ee`` camera's position, look-at point and up vector are given in
 the arm's ``ee_link`` frame and moved with it every frame. Images come from PyBullet's
-TinyRenderer (CPU, headless) by default; ``renderer="egl"`` loads PyBullet's EGL plugin (GPU
-where one exists, else Mesa's software rasteriser) once per world. Depth is metric along the
+TinyRenderer (CPU, headless). Depth is metric along the
 optical axis (m), ``far`` where nothing is hit.
 """
 
@@ -17,7 +16,7 @@ import pybullet as p
 
 from robocfg.config.cameras import TaskCamera
 
-Renderer = Literal["tiny", "egl"]
+Renderer = Literal["tiny"]
 
 
 @dataclass(frozen=True)
@@ -34,17 +33,6 @@ class CameraRig:
     def __init__(self, world, arm, cameras: list[TaskCamera], renderer: Renderer = "tiny"):
         self.world, self.arm, self.cameras = world, arm, list(cameras)
         self._renderer = p.ER_TINY_RENDERER
-        if renderer == "egl" and cameras:
-            import importlib.util
-
-            spec = importlib.util.find_spec("eglRenderer")
-            origin = spec.origin if spec is not None else None
-            plugin = p.loadPlugin(origin, "_eglRendererPlugin", physicsClientId=world.client) if origin else -1
-            if plugin < 0:
-                from robocfg.errors import RobocfgError
-
-                raise RobocfgError("the PyBullet EGL renderer plugin could not be loaded; use the tiny renderer")
-            self._renderer = p.ER_BULLET_HARDWARE_OPENGL
 
     def render_all(self) -> dict[str, CameraImage]:
         """One image per camera, keyed by camera name, of the world's current state."""
