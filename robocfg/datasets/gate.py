@@ -60,9 +60,11 @@ class CommandGate:
         values exactly representable in float32)."""
         a = self._round(np.append(self.q_wanted, self.g_wanted) if action is None else np.asarray(action))
         self._prev, self._cur = (a if first else self._cur), a
-        self._delta = a[:-1] - self._prev[:-1]
-        self._slope = self._delta / (self.steps_per_frame * self.world.dt)
-        self._moving = bool(np.any(self._delta))
+        n, delta = self.steps_per_frame, a[:-1] - self._prev[:-1]
+        # the interval's targets, computed once: the drives' per-step path then only sends them
+        self._ramp = (self._prev[:-1] + np.outer(np.arange(1, n + 1) / n, delta)).tolist()
+        self._slope = (delta / (n * self.world.dt)).tolist()
+        self._moving = bool(np.any(delta))
         g = float(a[-1])
         real = self._real_open if g > 0 else self._real_close
         if g != self._g_applied and real is not None:
@@ -74,8 +76,7 @@ class CommandGate:
         """Send the arm targets for physics step ``j`` (1..steps_per_frame) of the current interval."""
         if j > 1 and not self._moving:  # a held target is sent once per interval, not every step
             return
-        s = min(j, self.steps_per_frame) / self.steps_per_frame
-        self._real_command(self._prev[:-1] + s * self._delta, self._slope)
+        self._real_command(self._ramp[min(j, self.steps_per_frame) - 1], self._slope)
 
     @staticmethod
     def _round(a: np.ndarray) -> np.ndarray:
