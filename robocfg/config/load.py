@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 import yaml
 from pydantic import BaseModel, TypeAdapter, ValidationError
 
+from robocfg.config.prescan import MAX_DEPTH, check_depth, check_size
 from robocfg.errors import ConfigError, Problem
 from robocfg.suggest import did_you_mean
 
@@ -53,11 +54,18 @@ class _Composer(yaml.SafeLoader):
 
 
 # libyaml composes ~15x faster than the pure-Python parser; nodes and marks are the same.
-_FastComposer = getattr(yaml, "CSafeLoader", _Composer)
+class _FastComposer(getattr(yaml, "CSafeLoader", _Composer)):  # type: ignore[misc]
+    """The composer used; its scalar resolution is extended below."""
+
+
+# YAML 1.1 (PyYAML) reads ``1e-3`` as a string; numbers are validated strictly (no strings), so
+# exponents without a dot must resolve as floats, as in YAML 1.2.
+_EXP_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
+for _loader in {_Composer, _FastComposer}:
+    _loader.add_implicit_resolver("tag:yaml.org,2002:float", _EXP_FLOAT, list("-+0123456789."))
 
 
 MAX_NODES = 100_000  # after alias expansion: stops "billion laughs" documents
-MAX_DEPTH = 100
 _MERGE_TAG = "tag:yaml.org,2002:merge"
 _PLAIN_TAGS = ("tag:yaml.org,2002:map", "tag:yaml.org,2002:seq")
 
@@ -144,6 +152,9 @@ def load_yaml(path: str | Path) -> YamlDocument:
     """Read one YAML document safely. Raises ConfigError for I/O, syntax, duplicate keys, empty files."""
     p = Path(path)
     try:
+        too_big = check_size(p.stat().st_size) if p.is_file() else None
+        if too_big is not None:  # refused before reading it
+            raise ConfigError([Problem(str(p), too_big.line, too_big.col, "", too_big.message)])
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError([Problem(str(p), None, None, "", "file not found")]) from None
@@ -157,7 +168,11 @@ def load_yaml(path: str | Path) -> YamlDocument:
 
 
 def parse_yaml(text: str, path: Path) -> YamlDocument:
-    """Parse YAML text (see :func:`load_yaml`)."""
+    """Parse YAML text (see :func:`load_yaml`). Size and nesting depth are checked on the text
+    first: the C composer would overflow the stack on very deep nesting."""
+    for limit in (check_size(len(text.encode("utf-8", "surrogatepass"))), check_depth(text)):
+        if limit is not None:
+            raise ConfigError([Problem(str(path), limit.line, limit.col, "", limit.message)])
     try:
         loader = _FastComposer(text)
         try:

@@ -22,7 +22,7 @@ class Frozen(BaseModel):
     """Base for every config model: immutable, unknown keys rejected."""
 
     # defer_build: validators are built on first use, not at import (-0.1 s on `robocfg validate`).
-    model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=False, defer_build=True)
+    model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=False, defer_build=True, strict=True)
 
 
 class Pose(Frozen):
