@@ -11,6 +11,7 @@ import os
 import tempfile
 from pathlib import Path
 
+import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -140,3 +141,30 @@ def test_unmutated_documents_are_valid():
     assert load_robot(check).config.name == "panda"
     check.write_text(yaml.safe_dump(TASK))
     assert load_task(check).config.task == "pick_place"
+
+
+# Every other command's shipped task, mutated the same way: the command-block checks (waypoints,
+# hold_object, meshes, grasp objects, names) must also answer with ConfigError only.
+TASK_BASES = {stem: yaml.safe_load((ROOT / "robocfg" / "data" / "tasks" / f"{stem}.yaml").read_text())
+              for stem in ("gripper", "trajectory", "follow_target_obstacle", "grasp")}
+KIND_SETTINGS = settings(max_examples=40 * SCALE, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@pytest.mark.parametrize("stem", sorted(TASK_BASES))
+def test_mutated_task_kinds_only_raise_config_error(stem):
+    @KIND_SETTINGS
+    @given(st.lists(mutation, min_size=1, max_size=3))
+    def run(mutations):
+        data = TASK_BASES[stem]
+        for m in mutations:
+            data = _mutate(data, *m)
+        check_text(yaml.safe_dump(data))
+
+    run()
+
+
+def test_unmutated_task_kinds_are_valid():
+    check = Path(_TMP.name) / "kind.yaml"
+    for stem, data in TASK_BASES.items():
+        check.write_text(yaml.safe_dump(data))
+        assert load_task(check).config.task in stem, stem

@@ -105,3 +105,16 @@ def _exists(uri: str, cands: list[Path]) -> Path:
         if c.is_file():
             return c.resolve()
     raise UnresolvedPath(uri, cands)
+
+
+def body_asset(uri: str, base_dir: Path) -> Path:
+    """The file of a task body's ``mesh`` (a mesh or a URDF): ``pybullet_data://REL``, absolute, or
+    relative to the task file's folder ``base_dir``. UnresolvedPath when it does not exist."""
+    if uri.startswith("pybullet_data://"):
+        root = _package_root("pybullet_data")
+        if root is None:
+            raise UnresolvedPath(uri, [], "the pybullet package is not installed")
+        return _exists(uri, [root / uri[len("pybullet_data://") :]])
+    p = Path(uri).expanduser()
+    return _exists(uri, [p if p.is_absolute() else base_dir / p])
+

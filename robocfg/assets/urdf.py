@@ -6,6 +6,7 @@ movable joints in the file, the same order PyBullet uses for its joint indices.
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -193,6 +194,45 @@ def read_urdf_xml(path: Path | str) -> ET.Element:
         return ET.fromstring(re.sub(rb"<robot\b", b"<robot" + decl, data, count=1))
 
 
+_NUMERIC_ATTRS = frozenset({"xyz", "rpy", "lower", "upper", "effort", "velocity", "value", "size", "radius",
+                            "length", "scale", "multiplier", "offset", "damping", "friction",
+                            "ixx", "ixy", "ixz", "iyy", "iyz", "izz"})
+_NON_FINITE = re.compile(rb"(?i)nan|inf")
+
+
+def _check_finite(path: Path) -> None:
+    """UrdfParseError at the line of the first numeric attribute holding ``nan`` or ``inf``: such
+    an origin, limit or inertia poisons every transform, and PyBullet/pinocchio fail far from the cause."""
+    import xml.parsers.expat
+
+    data = Path(path).read_bytes()
+    if not _NON_FINITE.search(data):
+        return  # the common case: no candidate token at all, no second parse
+    parser = xml.parsers.expat.ParserCreate()
+    found: list[tuple[int, str]] = []
+
+    def start(tag: str, attrs: dict[str, str]) -> None:
+        for key, text in attrs.items():
+            if found or key not in _NUMERIC_ATTRS:
+                continue
+            for token in text.split():
+                try:
+                    bad = not np.isfinite(float(token))
+                except ValueError:
+                    bad = False  # not a number at all: reported by the parse itself
+                if bad:
+                    found.append((parser.CurrentLineNumber, f'<{tag} {key}="{text}">: {token!r} is not a finite number'))
+                    return
+
+    parser.StartElementHandler = start
+    try:
+        parser.Parse(data, True)
+    except xml.parsers.expat.ExpatError:
+        return  # prefixes the reader declares itself; the values it reads are checked when used
+    if found:
+        raise UrdfParseError(found[0][1], found[0][0])
+
+
 def parse_urdf(path: Path) -> Urdf:
     """Parse a URDF file. Raises UrdfParseError with a line number when the XML is broken."""
     try:
@@ -203,6 +243,7 @@ def parse_urdf(path: Path) -> Urdf:
         raise UrdfParseError(f"cannot read: {exc}") from None
     if root.tag != "robot":
         raise UrdfParseError(f"top element is <{root.tag}>, expected <robot>", 1)
+    _check_finite(path)
     try:
         links: dict[str, Link] = {}
         for el in root.findall("link"):

@@ -12,6 +12,7 @@ import numpy as np
 from pydantic import TypeAdapter
 
 from robocfg.checks.robot import CheckedRobot, load_robot
+from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
 from robocfg.config.overrides import apply_overrides, blame_overrides
@@ -92,6 +93,8 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
             problems.append(doc.problem(loc, f"robot {mount.robot or mount.robot_config_file!r} is invalid ({len(exc.problems)} problem(s) below)"))
             problems.extend(exc.problems)
     warnings: list[Problem] = []
+    if not problems:
+        problems += check_task_params(doc, config, robots[0])
     if not problems and isinstance(config, PickPlaceTask):
         _check_pick_place(doc, config, robots[0], problems, warnings)
     if problems or (strict and warnings):

@@ -21,7 +21,7 @@ def validate(
     from robocfg.checks import load_robot, load_task
     from robocfg.config import catalog
     from robocfg.config.load import detect_kind, load_yaml
-    from robocfg.errors import ConfigError
+    from robocfg.errors import ConfigError, Problem
 
     files = _collect(paths) if paths else [*catalog.available("robots").values(), *catalog.available("tasks").values()]
     out, err = console(), console(stderr=True)
@@ -32,6 +32,8 @@ def validate(
     for f in files:
         kind, problems, warnings = "?", [], []
         try:
+            if f.is_dir():  # _collect keeps a folder only when it holds no YAML: nothing checked is no "ok"
+                raise ConfigError([Problem(str(f), None, None, "", "no YAML files (*.yaml, *.yml) in this folder")])
             kind = detect_kind(load_yaml(f))
             checked = load_robot(f, strict) if kind == "robot" else load_task(f, strict)
             warnings = checked.warnings
@@ -57,7 +59,8 @@ def _collect(paths: list[Path]) -> list[Path]:
     files: list[Path] = []
     for p in paths:
         if p.is_dir():
-            files += sorted(x for x in p.rglob("*") if x.suffix in (".yaml", ".yml"))
+            found = sorted(x for x in p.rglob("*") if x.suffix in (".yaml", ".yml") and x.is_file())
+            files += found or [p]
         else:
             files.append(p)
     return files

@@ -269,6 +269,8 @@ def _message(err: dict) -> str:
         msg = msg[len("Value error, ") :]
     if err["type"] == "missing":
         msg = "required field is missing"
+    if err["type"] in ("float_type", "int_type", "bool_type", "string_type") and isinstance(err.get("input"), (bool, int, float, str)):
+        msg = f"{msg} (got {err['input']!r})"
     if err["type"] == "literal_error" and "input" in err:
         msg = f"{msg} (got {err['input']!r})"
     return msg

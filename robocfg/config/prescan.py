@@ -21,7 +21,10 @@ MAX_BYTES = 256 * 1024  # a robot or task YAML is a few KB; 256 KiB composes in 
 MAX_DEPTH = 100  # nesting levels (mappings and sequences)
 
 _BLOCK_SCALAR = re.compile(r"(?:^|[\s:-])[|>][+-]?[0-9]?[+-]?\s*$")
-_OPENERS = frozenset("-:?,[{")  # after one of these (or at a line start) a node may begin
+# A node (quoted scalar, flow collection) may begin after one of these ("" = line start); inside
+# a plain scalar such as ``x[1]`` brackets and quotes are text.
+_BLOCK_OPENERS = frozenset(["", "-", ":", "?"])
+_FLOW_OPENERS = frozenset(["", "-", ":", "?", ",", "[", "{"])
 
 
 @dataclass(frozen=True)
@@ -79,9 +82,10 @@ def check_depth(text: str, limit: int = MAX_DEPTH) -> TextLimitExceeded | None:
                 continue
             if ch == "#" and (i == 0 or line[i - 1] in " \t"):
                 break
-            if ch in "'\"" and (prev in _OPENERS or prev == ""):
+            starts_node = prev in (_FLOW_OPENERS if flow else _BLOCK_OPENERS)
+            if ch in "'\"" and starts_node:
                 quote = ch
-            elif ch in "[{" and (flow or prev in _OPENERS or prev == ""):
+            elif ch in "[{" and starts_node:
                 flow += 1
             elif ch in "]}" and flow:
                 flow -= 1

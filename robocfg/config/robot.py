@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from robocfg.config.types import (
     Axis,
@@ -19,8 +19,14 @@ from robocfg.config.types import (
     Matrix3,
     NonNegFloat,
     PositiveFloat,
+    SchemaVersion,
     Vec3,
 )
+from robocfg.suggest import did_you_mean
+
+# Names of the IK backends built into robocfg.kinematics.ik (config must not import the solvers;
+# a test checks this table against the backend registry).
+IK_BACKENDS = ("lm", "pink", "placo")
 
 
 class ParallelGripperConfig(Frozen):
@@ -180,7 +186,7 @@ class Attachment(Frozen):
 class RobotConfig(Frozen):
     """A robot YAML file."""
 
-    schema_version: Literal[1] = Field(description="File format version; this is 1.")
+    schema_version: SchemaVersion = Field(description="File format version; this is 1.")
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", description="Robot name used on the command line.")
     description: str = Field("", description="Free text, shown by `robocfg robots`.")
     urdf: str = Field(description="Path relative to this YAML, or pybullet_data://, airo_models://, package://.")
@@ -192,7 +198,14 @@ class RobotConfig(Frozen):
     arms: list[ArmConfig] = Field(min_length=1, description="One entry per arm.")
     drives: Drives = Field(default_factory=Drives, description="Drive gains and joint-limit overrides.")
     physics: Physics = Field(default_factory=Physics, description="Solver settings and link-mass overrides.")
-    ik_backend: str = Field("lm", description="Default IK backend name.")
+    ik_backend: str = Field("lm", description=f"Default IK backend name: {', '.join(IK_BACKENDS)}.")
+
+    @field_validator("ik_backend")
+    @classmethod
+    def _known_backend(cls, v: str) -> str:
+        if v not in IK_BACKENDS:
+            raise ValueError(f"unknown IK backend {v!r}{did_you_mean(v, IK_BACKENDS)}; known: {', '.join(IK_BACKENDS)}")
+        return v
 
     @model_validator(mode="after")
     def _unique_arms(self) -> RobotConfig:

@@ -63,23 +63,15 @@ class Scene(Frozen):
     ground: bool = Field(True, description="Add a ground plane at z = 0.")
     table: Table | None = Field(None, description="Optional static table.")
     pedestal: Pedestal | None = Field(None, description="Optional static pedestal (place the robot on its top face).")
-    objects: list[Body] = Field(default_factory=list, description="Movable objects.")
+    objects: list[Body] = Field(default_factory=list, description="Movable objects (names unique among objects and obstacles).")
     obstacles: list[Body] = Field(default_factory=list, description="Static obstacles (mass is ignored).")
-
-    @model_validator(mode="after")
-    def _unique_names(self) -> Scene:
-        names = [b.name for b in [*self.objects, *self.obstacles]]
-        dup = {n for n in names if names.count(n) > 1}
-        if dup:
-            raise ValueError(f"object/obstacle names must be unique: {sorted(dup)}")
-        return self
 
 
 class Sim(Frozen):
     """Simulation settings."""
 
     timestep: PositiveFloat = Field(1.0 / 240.0, description="Physics step (s).")
-    seed: int = Field(0, description="Seed for every random choice.")
+    seed: int = Field(0, ge=0, description="Seed for every random choice (>= 0).")
     gui: bool = Field(False, description="Open the PyBullet GUI (same as --gui).")
     max_duration: PositiveFloat = Field(60.0, description="Simulated-time cap for a run (s).")
     gravity: Vec3 = Field(default_factory=lambda: [0.0, 0.0, -9.81], description="m/s².")

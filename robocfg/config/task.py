@@ -15,7 +15,7 @@ from robocfg.config.commands import (
     TrajectoryParams,
 )
 from robocfg.config.scene import Scene, Sim
-from robocfg.config.types import Frozen, Pose
+from robocfg.config.types import Frozen, Pose, SchemaVersion
 
 
 class RobotMount(Pose):
@@ -33,7 +33,7 @@ class RobotMount(Pose):
 
 
 class _TaskBase(Frozen):
-    schema_version: Literal[1] = Field(description="File format version; this is 1.")
+    schema_version: SchemaVersion = Field(description="File format version; this is 1.")
     description: str = Field("", description="Free text.")
     robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
     scene: Scene = Field(default_factory=Scene, description="Everything in the world besides the robots.")

@@ -5,12 +5,21 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 Axis = Literal["x", "y", "z"]
 AXIS_INDEX: dict[str, int] = {"x": 0, "y": 1, "z": 2}
 
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+
+
+def _not_bool(v: object) -> object:
+    if isinstance(v, bool):  # True == 1, so Literal[1] alone would take it
+        raise ValueError(f"expected the number 1, got {v!r}")
+    return v
+
+
+SchemaVersion = Annotated[Literal[1], BeforeValidator(_not_bool)]
 Vec3 = Annotated[list[FiniteFloat], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[FiniteFloat], Field(min_length=4, max_length=4)]
 Matrix3 = Annotated[list[Vec3], Field(min_length=3, max_length=3)]

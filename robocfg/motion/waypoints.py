@@ -21,13 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robocfg.checks.waypoints import PositionLimits, check_within, joint_waypoint
 from robocfg.config.types import Pose
 from robocfg.errors import ConfigError, Problem, RunFailed
 from robocfg.geometry import pose_matrix
 from robocfg.motion.limits import JointLimits
-from robocfg.suggest import did_you_mean
 
-LIMIT_TOL = 1e-9
 IK_POS_TOL = 1e-3  # m
 IK_ROT_TOL = 1e-2  # rad
 IK_JUMP_WARN = 1.5  # rad: an IK answer this far from the previous waypoint (one joint) earns a warning
@@ -51,23 +50,16 @@ class Waypoints:
 def resolve_waypoints(items: list, limits: JointLimits, home: np.ndarray, problem: ProblemFn,
                       ik: IKFn | None = None) -> Waypoints:
     """Turn the task's waypoint entries into joint values. See the module docstring."""
-    names = list(limits.names)
     problems: list[Problem] = []
     rows: list[np.ndarray] = []
     kinds: list[str] = []
     ik_errors: dict[int, tuple[float, float]] = {}
     warnings: list[str] = []
     prev = np.asarray(home, dtype=float)
+    position_limits = PositionLimits(limits.names, limits.lower, limits.upper, limits.bounded())
     for i, item in enumerate(items):
         q: np.ndarray | None = None
-        if isinstance(item, str):
-            kinds.append("home")
-            if item == "home":
-                q = np.asarray(home, dtype=float).copy()
-            else:
-                problems.append(problem((i,), f"unknown waypoint name {item!r}{did_you_mean(item, ['home'])} "
-                                              "(the only named waypoint is 'home')"))
-        elif isinstance(item, Pose):
+        if isinstance(item, Pose):
             kinds.append("pose")
             if ik is None:
                 problems.append(problem((i,), "Cartesian waypoints need a kinematic model (none available)"))
@@ -84,39 +76,14 @@ def resolve_waypoints(items: list, limits: JointLimits, home: np.ndarray, proble
                     warnings.append(f"waypoint {i}: the IK answer moves {limits.names[k]} by {jump[k]:.2f} rad from the "
                                     "previous waypoint (another IK branch?); add an intermediate waypoint if that is not intended")
                 ik_errors[i] = (float(res.pos_err), float(res.rot_err))  # type: ignore[attr-defined]
-        elif isinstance(item, dict):
-            kinds.append("map")
-            q = prev.copy()
-            for jn, v in item.items():
-                if jn not in names:
-                    problems.append(problem((i, jn), f"{jn!r} is not an arm joint{did_you_mean(jn, names)} (arm joints: {', '.join(names)})"))
-                    q = None
-                    break
-                q[names.index(jn)] = float(v)
+                check_within(i, q, position_limits, "pose", problem, problems)
         else:
-            kinds.append("list")
-            if len(item) != len(names):
-                problems.append(problem((i,), f"waypoint {i} has {len(item)} values for {len(names)} arm joints ({', '.join(names)})"))
-            else:
-                q = np.asarray(item, dtype=float)
+            kind, q = joint_waypoint(i, item, position_limits, home, prev, problem, problems)
+            kinds.append(kind)
         if q is None:
             continue
-        given = set(item) if isinstance(item, dict) else None  # a map's other joints were checked before
-        _check_limits(i, q, limits, kinds[-1], problem, problems, given)
         rows.append(q)
         prev = q
     if problems:
         raise ConfigError(problems)
     return Waypoints(np.array(rows), kinds, ik_errors, warnings)
-
-
-def _check_limits(i: int, q: np.ndarray, limits: JointLimits, kind: str, problem: ProblemFn,
-                  problems: list[Problem], only: set[str] | None = None) -> None:
-    bounded = limits.bounded()
-    for k, (jn, v) in enumerate(zip(limits.names, q, strict=True)):
-        if not bounded[k] or (only is not None and jn not in only):
-            continue
-        lo, hi = limits.lower[k], limits.upper[k]
-        if v < lo - LIMIT_TOL or v > hi + LIMIT_TOL:
-            loc = (i, jn) if kind == "map" else ((i, k) if kind == "list" else (i,))
-            problems.append(problem(loc, f"waypoint {i}: {jn} = {v:.4f} is outside its limits [{lo:.4f}, {hi:.4f}]"))

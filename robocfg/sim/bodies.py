@@ -11,6 +11,7 @@ from pathlib import Path
 import pybullet as p
 import pybullet_data
 
+from robocfg.assets.paths import UnresolvedPath, body_asset
 from robocfg.config.scene import Body, Pedestal, Table
 from robocfg.errors import NotFound, RobocfgError
 
@@ -38,15 +39,10 @@ def _shapes(client: int, body: Body, base_dir: Path) -> tuple[int, int]:
 
 def resolve_asset(uri: str, base_dir: Path) -> Path:
     """A mesh/URDF path: ``pybullet_data://REL``, absolute, or relative to the task file's folder."""
-    if uri.startswith("pybullet_data://"):
-        cand = Path(pybullet_data.getDataPath()) / uri[len("pybullet_data://") :]
-    else:
-        cand = Path(uri).expanduser()
-        if not cand.is_absolute():
-            cand = base_dir / cand
-    if not cand.is_file():
-        raise NotFound("mesh file", uri, [str(cand)])
-    return cand
+    try:
+        return body_asset(uri, base_dir)
+    except UnresolvedPath as exc:
+        raise NotFound("mesh file", uri, [str(t) for t in exc.tried]) from None
 
 
 def spawn_body(client: int, body: Body, base_dir: Path, static: bool = False) -> int:
