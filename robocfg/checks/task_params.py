@@ -16,7 +16,7 @@ from robocfg.assets.paths import UnresolvedPath, body_asset
 from robocfg.checks.robot import CheckedRobot
 from robocfg.checks.waypoints import PositionLimits, check_joint_waypoints
 from robocfg.config.load import Loc, YamlDocument
-from robocfg.config.robot import ParallelGripperConfig, SuctionGripperConfig
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
 from robocfg.config.task import (
     FollowTargetTask,
@@ -97,12 +97,7 @@ def _check_gripper(doc: YamlDocument, task: GripperTask, robot: CheckedRobot) ->
                                            "'run gripper' needs one")]
     name = task.gripper.hold_object
     known = [b.name for b in task.scene.objects]
-    if name is None:
-        if isinstance(g, SuctionGripperConfig):
-            return [doc.problem(("gripper",), "a suction gripper is tested by holding an object: set gripper.hold_object "
-                                              f"to one of scene.objects ({', '.join(known) or 'none defined'})")]
-        return []
-    if name not in known:
+    if name is not None and name not in known:
         return [doc.problem(("gripper", "hold_object"), f"no object {name!r} in scene.objects{did_you_mean(name, known)} "
                                                         f"(known: {', '.join(known) or 'none'})")]
     return []
