@@ -15,7 +15,7 @@ Everything is derived from the URDF's structure and geometry, never from names:
   distal ``PAD_LENGTH`` of each finger's geometry);
 * **R_ee_graspnet** — rows are the grasp axes in the ``ee_link`` frame: x = approach
   (``+ee_axis``), y = the ``+`` ee axis closest to the pad-to-pad line (finger closing axis),
-  z = x × y (design.md §3);
+  z = x × y;
 * **home** — 0 where 0 is well inside a joint's limits (10 % of the range), else mid-limits.
 
 Frames: all geometry in the ``ee_link`` frame, metres. No printing here: the CLI reports the notes.

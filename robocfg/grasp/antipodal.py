@@ -1,10 +1,10 @@
-"""Antipodal grasp candidates from an object point cloud with normals (seed 003, tier 2), scored
+"""Antipodal grasp candidates from an object point cloud with normals, scored
 analytically instead of by a CNN.
 
 Pipeline (world frame, m): (1) sample seed points; for each, find partners within the usable
 finger gap whose contact line lies inside *both* friction cones (half angle atan μ), plus a level
 variant of steep pairs; (2) around each contact axis, try several approach directions (top-down
-first) → GraspNet-frame poses (x approach, y closing; design.md §3); (3) reject poses whose
+first) → GraspNet-frame poses (x approach, y closing); (3) reject poses whose
 gripper boxes, swept back along the approach by the pre-grasp stand-off, dip below the support
 plane or contain a scene point; (4) re-measure what the closing fingers would really touch
 (outermost object points in the finger sweep), re-centre, and re-check width, antipodality

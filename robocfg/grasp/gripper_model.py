@@ -2,7 +2,7 @@
 
 Every link rigidly or movably attached below ``ee_link`` (and ``ee_link`` itself) becomes one
 axis-aligned box in the GraspNet grasp frame (origin at the TCP, x = approach, y = closing,
-z = x × y; design.md §3), measured with the gripper open, and again at ``CLOSING_SAMPLES``
+z = x × y), measured with the gripper open, and again at ``CLOSING_SAMPLES``
 openings down to closed (with an oriented box per link, for linkages). No per-robot numbers: the
 boxes come from PyBullet's collision shapes (mesh vertices and primitive corners), so any robot
 YAML works. A cloud point inside a box means the gripper would hit it; extending the boxes back

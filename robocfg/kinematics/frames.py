@@ -1,4 +1,4 @@
-"""Grasp frames and the one conversion every grasping command uses (design.md §3).
+"""Grasp frames and the one conversion every grasping command uses (no per-robot constants).
 
 GraspNet grasp frame: origin at the grasp centre between the fingers, x = approach direction
 (gripper → object), y = finger closing direction, z = x × y. ``R_ee_graspnet`` is constant with
