@@ -121,3 +121,12 @@ def test_async_vector_env_with_two_workers():
         assert reward.shape == (2,)
     finally:
         envs.close()
+
+
+def test_step_time_is_exact_whole_physics_steps():
+    env = gym.make("robocfg/Reach-v0", robot="panda", step_time=0.04).unwrapped
+    env.reset(seed=0)
+    env.step(np.zeros(3))
+    assert env.world.dt * env.substeps == pytest.approx(0.04)
+    assert env.world.t == pytest.approx(0.04)  # one env step = 0.04 s simulated
+    env.close()

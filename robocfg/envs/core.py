@@ -12,7 +12,7 @@ drives. ``control="joints"``: one value per arm joint, scaled by ``joint_step`` 
 Tasks that use the gripper add one last action: > 0 opens, < 0 closes (a parallel gripper takes
 the opening fraction ``(a + 1) / 2``; a suction cup switches on below zero).
 
-The workspace is placed under the robot's home TCP, so goals suit robots of any size. Each
+The workspace lies on the ground just beyond the robot's home TCP, so goals suit robots of any size. Each
 ``step`` advances ``step_time`` s of simulated time (0.04 s, panda-gym's default). ``reset``
 restores a physics snapshot taken once after building, so resets are cheap; ``reset(seed=…)``
 makes the episode reproducible.
@@ -38,10 +38,10 @@ RewardType = Literal["sparse", "dense"]
 
 @dataclass(frozen=True)
 class Workspace:
-    """Axis-aligned region (world m) where goals and objects are sampled, centred under the
-    robot's home TCP at ground level; ``lo``/``hi`` bound the TCP targets."""
+    """Axis-aligned region (world m) where goals and objects are sampled, on the ground just
+    beyond the robot's home TCP; ``lo``/``hi`` bound the TCP targets."""
 
-    center: np.ndarray  # (3,) ground point below the home TCP
+    center: np.ndarray  # (3,) ground point a half-width beyond the home TCP, away from the base
     half: float  # m, half side of the sampling square
     lo: np.ndarray  # (3,) lowest TCP target
     hi: np.ndarray  # (3,) highest TCP target
@@ -71,10 +71,12 @@ class RobotEnv(gym.Env):
         self.distance_threshold, self.ee_step, self.joint_step = distance_threshold, ee_step, joint_step
         self.render_size = render_size
         task = api.load_task("pick_place", robot=robot)
+        # physics step: the task's, shortened so that a whole number of them make ``step_time``
+        self.substeps = max(1, int(np.ceil(step_time / task.config.sim.timestep - 1e-9)))
+        task = task.with_overrides({"sim.timestep": step_time / self.substeps})
         self.world = api.make_world(task)
         self.arm = self.world.robot.arm()
         self.gripper = self.arm.gripper
-        self.substeps = max(1, round(step_time / self.world.dt))
         self.step_time = self.substeps * self.world.dt
         body = task.config.pick_place.object  # type: ignore[union-attr]  (a 5 cm, 0.1 kg cube)
         self.object, self.object_half_height = body.name, body.size[2] / 2
@@ -85,15 +87,17 @@ class RobotEnv(gym.Env):
         self.model.solver("lm").max_total_iter = 60  # reproducible: bounded by iterations, not time
         home_tcp = self.arm.tcp_pose()
         self.R_down = self._top_down_rotation(home_tcp)
-        c = np.array([home_tcp[0, 3], home_tcp[1, 3], 0.0])
-        reach = float(np.linalg.norm(home_tcp[:2, 3] - self.world.robot.base_pose()[:2, 3]))
+        out = home_tcp[:2, 3] - self.world.robot.base_pose()[:2, 3]  # base → home TCP, horizontal
+        reach = float(np.linalg.norm(out))
         half = float(np.clip(0.3 * reach, 0.08, 0.15))
+        # centred a half-width beyond the home TCP: close to the base, top-down poses run out
+        c = np.array([*(home_tcp[:2, 3] + half * out / max(reach, 1e-9)), 0.0])
         self.workspace = Workspace(c, half, c + np.array([-2 * half, -2 * half, 0.0]),
                                    c + np.array([2 * half, 2 * half, max(0.3, 0.8 * home_tcp[2, 3])]))
         self.world.step(1)
         self._state = self.world.snapshot()
         self.goal = np.zeros(3)
-        self._prev_tcp = home_tcp[:3, 3].copy()
+        self._prev_tcp = self._tcp = home_tcp[:3, 3].copy()
         n_act = self.model.nq if control == "joints" else 3
         n_act += 1 if self.uses_gripper else 0
         self.action_space = spaces.Box(-1.0, 1.0, shape=(n_act,), dtype=np.float32)
@@ -110,7 +114,7 @@ class RobotEnv(gym.Env):
         """Put objects where this episode wants them (after the snapshot is restored)."""
 
     def _achieved(self) -> np.ndarray:
-        return self.tcp()
+        return self._tcp
 
     def _task_observation(self) -> np.ndarray:
         return np.zeros(0)
@@ -125,14 +129,14 @@ class RobotEnv(gym.Env):
         self.steps = 0
         self._place_scene()
         self.goal = self._sample_goal()
-        self._prev_tcp = self.tcp()
+        self._prev_tcp = self._tcp = self.tcp()
         self._target_q = self.arm.joint_positions()
         return self._observe(), self._info()
 
     def step(self, action):
         a = np.clip(np.asarray(action, dtype=float), -1.0, 1.0)
         self._apply(a)
-        self._prev_tcp = self.tcp()
+        self._prev_tcp = self._tcp  # TCP read at the last observation: nothing moved since
         self.world.step(self.substeps)
         self.steps += 1
         self._advance_goal()
@@ -171,7 +175,7 @@ class RobotEnv(gym.Env):
         return self.arm.tcp_pose()[:3, 3].copy()
 
     def _observe(self) -> dict[str, np.ndarray]:
-        tcp = self.tcp()
+        tcp = self._tcp = self.tcp()  # read once per step (observation, goal, next action)
         vel = (tcp - self._prev_tcp) / self.step_time if hasattr(self, "steps") else np.zeros(3)
         parts = [tcp, vel]
         if self.uses_gripper:
@@ -191,12 +195,13 @@ class RobotEnv(gym.Env):
 
     def _apply(self, a: np.ndarray) -> None:
         if self.control == "ee":
-            target = np.clip(self.tcp() + self.ee_step * a[:3], self.workspace.lo, self.workspace.hi)
+            target = np.clip(self._tcp + self.ee_step * a[:3], self.workspace.lo, self.workspace.hi)
             T = np.eye(4)
             T[:3, :3], T[:3, 3] = self.R_down, target
             res = self.model.ik(T, seed_q=self.arm.joint_positions(), backend="lm", time_budget=1.0,
                                 rng=np.random.default_rng(0))
-            if res.converged or res.pos_err < 0.02:
+            # a partial answer still helps when it gets closer than where the TCP is now
+            if res.converged or (res.pos_err < float(np.linalg.norm(target - self._tcp)) and res.rot_err < 0.2):
                 self._target_q = res.q
         else:
             n = self.model.nq
