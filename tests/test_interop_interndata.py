@@ -62,6 +62,22 @@ def test_round_trip_gives_the_same_robot(name, tmp_path):
         assert data[f"{side}_joint_home"] == list(arm.home)
 
 
+def _assert_same_arms(robot: CheckedRobot, back: CheckedRobot) -> None:
+    """Every arm field their keys carry, and the gripper robocfg completes from the URDF, agree."""
+    assert len(back.config.arms) == len(robot.config.arms)
+    for a, b in zip(robot.config.arms, back.config.arms, strict=True):
+        assert back.arm_joints(b) == robot.arm_joints(a)
+        for key in ("name", "base_link", "ee_link", "tcp_offset", "ee_axis", "R_ee_graspnet", "home", "home_std",
+                    "collision_filter"):
+            assert getattr(b, key) == getattr(a, key), key
+        if a.gripper_keypoints is not None:
+            assert b.gripper_keypoints == a.gripper_keypoints
+        assert back.gripper_joints(b) == robot.gripper_joints(a)
+        for key in ("open", "closed", "max_width", "min_width"):
+            assert getattr(b.gripper, key) == getattr(a.gripper, key), key
+        assert sorted(b.gripper.finger_links) == sorted(a.gripper.finger_links)  # the pair, found from the geometry
+
+
 @pytest.mark.parametrize("name", ["panda", "dual_panda", "ur5e_robotiq_2f85"])
 def test_their_keys_alone_give_the_same_arms(name, tmp_path):
     """Without our block (a file from their users), --urdf and their keys give the same arms."""
@@ -69,16 +85,16 @@ def test_their_keys_alone_give_the_same_arms(name, tmp_path):
     data = yaml.safe_load(theirs.read_text())
     data.pop("robocfg")
     theirs.write_text(yaml.safe_dump(data, sort_keys=False))
-    back = import_interndata(theirs, tmp_path / "ours" / f"{name}.yaml", str(robot.urdf_path)).robot
-    assert len(back.config.arms) == len(robot.config.arms)
-    for a, b in zip(robot.config.arms, back.config.arms, strict=True):
-        assert back.arm_joints(b) == robot.arm_joints(a)
-        for key in ("base_link", "ee_link", "tcp_offset", "ee_axis", "R_ee_graspnet", "home", "home_std", "collision_filter"):
-            assert getattr(b, key) == getattr(a, key), key
-        assert back.gripper_joints(b) == robot.gripper_joints(a)
-        for key in ("open", "closed", "max_width", "min_width"):
-            assert getattr(b.gripper, key) == getattr(a.gripper, key), key
-        assert sorted(b.gripper.finger_links) == sorted(a.gripper.finger_links)  # the pair, found from the geometry
+    _assert_same_arms(robot, import_interndata(theirs, tmp_path / "ours" / f"{name}.yaml", str(robot.urdf_path)).robot)
+
+
+@pytest.mark.parametrize("name", ["panda", "dual_panda", "ur5e_robotiq_2f85", "xarm6"])
+def test_hand_written_files_give_the_built_in_arms(name, tmp_path):
+    """tests/interndata/NAME.yaml, written from their template, on the URDF robocfg uses for NAME."""
+    robot = load_robot(BUILTIN_DIR / "robots" / f"{name}.yaml")
+    result = import_interndata(DATA / f"{name}.yaml", tmp_path / f"{name}.yaml", str(robot.urdf_path))
+    _assert_same_arms(robot, result.robot)
+    assert not result.warnings
 
 
 def test_dual_arm_indices_interleave_in_isaac_order(tmp_path):
@@ -97,7 +113,7 @@ def test_hand_written_template_file_imports(tmp_path):
     assert arm.gripper is not None and arm.gripper.joints == ["panda_finger_joint1"]  # type: ignore[union-attr]
     assert arm.gripper.closed == [0.0] and arm.gripper.finger_links == ref.gripper.finger_links  # type: ignore[union-attr]
     assert result.robot.config.physics.solver_iterations == 128
-    dropped = dict(result.dropped)
+    dropped = {d.key: d.why for d in result.dropped}
     assert "panda_finger_joint2" in dropped["left_gripper_indices"]
     assert {"target_class", "path", "robot_file", "stabilization_threshold"} <= set(dropped)
 
@@ -203,7 +219,7 @@ def test_doc_commands_run(tmp_path, capsys, monkeypatch):
 def test_keys_outside_their_template_are_dropped(tmp_path):
     p, _ = _variant(tmp_path, "lift_home: []", "lift_home: []\nsim_camera_mount: head_link")
     result = import_interndata(p, tmp_path / "out.yaml", "pybullet_data://franka_panda/panda.urdf")
-    assert "template" in dict(result.dropped)["sim_camera_mount"]
+    assert "template" in {d.key: d.why for d in result.dropped}["sim_camera_mount"]
 
 
 @pytest.mark.parametrize(("index", "owner"), [(0, "a left arm joint"), (7, "a left gripper joint")])

@@ -40,8 +40,8 @@ def import_interndata(
     out, err = console(), console(stderr=True)
     for w in result.warnings:
         err.print(w.format(), markup=False)
-    for key, why in result.dropped:
-        out.print(f"dropped {key}: {why}", markup=False)
+    for d in result.dropped:
+        out.print(f"dropped {d.key}: {d.why}", markup=False)
     for note in result.notes:
         out.print(f"derived {note}", markup=False)
     arms = ", ".join(f"{a.name} ({len(result.robot.arm_joints(a))} joints, ee_link {a.ee_link})" for a in result.robot.config.arms)

@@ -37,7 +37,7 @@ from robocfg.config.load import (
 from robocfg.config.robot import Attachment
 from robocfg.errors import ConfigError, Problem
 from robocfg.interop.extension import BLOCK_KEY, overlay, rebase_paths
-from robocfg.interop.interndata_map import Mapped, map_interndata
+from robocfg.interop.interndata_map import Dropped, Mapped, map_interndata
 from robocfg.interop.interndata_schema import InterndataRobot
 from robocfg.suggest import did_you_mean
 
@@ -48,7 +48,7 @@ class ImportResult:
 
     output: Path
     robot: CheckedRobot
-    dropped: list[tuple[str, str]] = field(default_factory=list)  # (their key, why)
+    dropped: list[Dropped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)  # values derived rather than read
     warnings: list[Problem] = field(default_factory=list)  # on their file where the field came from it
 
@@ -62,12 +62,12 @@ def import_interndata(their_path: Path, output: Path, urdf: str | None = None) -
     block = data.pop(BLOCK_KEY, None)
     if block is not None and not isinstance(block, dict):
         raise ConfigError([doc.problem((BLOCK_KEY,), "must be a mapping (robocfg fields with no InternDataEngine key)")])
-    dropped: list[tuple[str, str]] = []
+    dropped: list[Dropped] = []
     known = list(InterndataRobot.model_fields)
     for key in list(data):
         if key not in known and not did_you_mean(str(key), known):
             data.pop(key)
-            dropped.append((str(key), "not a key of InternDataEngine's robot template"))
+            dropped.append(Dropped(str(key), "not a key of InternDataEngine's robot template"))
     their: InterndataRobot = validate_document(YamlDocument(doc.path, data, doc.marks), InterndataRobot)
     out_dir = output.parent
     out_dir.mkdir(parents=True, exist_ok=True)  # relative paths are resolved from it ("dir/../x" needs dir)
@@ -77,7 +77,7 @@ def import_interndata(their_path: Path, output: Path, urdf: str | None = None) -
     if urdf is not None:
         for key in ("urdf", "attachments", "package_dirs"):
             if block.pop(key, None) is not None:
-                dropped.append((f"{BLOCK_KEY}.{key}", "--urdf given: that URDF is the whole robot"))
+                dropped.append(Dropped(f"{BLOCK_KEY}.{key}", "--urdf given: that URDF is the whole robot"))
         robot["urdf"] = urdf if "://" in urdf else _uri(Path(urdf), out_dir)
         parsed = _parse(doc, robot["urdf"], [], {}, out_dir)
     elif isinstance(block.get("urdf"), str):

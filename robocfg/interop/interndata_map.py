@@ -32,13 +32,21 @@ KEYPOINT_ERROR_DEG = 45.0  # tool_tail → tool_head further than this from +ee_
 KEYPOINT_WARN_DIST = 0.01  # m: tool_head's distance along ee_axis vs tcp_offset
 
 
+@dataclass(frozen=True)
+class Dropped:
+    """A key of their file that robocfg does not keep, and why."""
+
+    key: str
+    why: str
+
+
 @dataclass
 class Mapped:
     """Our robot fields mapped from their file (``arms`` etc.), plus provenance and notes."""
 
     robot: dict[str, Any]
     origin: dict[str, tuple[Loc, bool]] = field(default_factory=dict)  # our loc → (their loc, index suffix applies)
-    dropped: list[tuple[str, str]] = field(default_factory=list)  # (their key, why)
+    dropped: list[Dropped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     warnings: list[Problem] = field(default_factory=list)  # on their file
     leaders: dict[int, list[str]] = field(default_factory=dict)  # arm index → driven gripper joints
@@ -112,7 +120,7 @@ def map_interndata(doc: YamlDocument, their: InterndataRobot, urdf: Urdf) -> Map
         for k, jn in enumerate(names):
             if jn in taken:
                 m.error(("lift_indices", k), f"DOF index {their.lift_indices[k]} is {jn!r}, {taken[jn]}")
-        out.dropped.append(("lift_indices / lift_home", f"robocfg has no lift joint group: {names} stay at their URDF "
+        out.dropped.append(Dropped("lift_indices / lift_home", f"robocfg has no lift joint group: {names} stay at their URDF "
                             "zero position (they are checked to exist and to be outside the arms)"))
     for key, why in (("target_class", "robocfg robots are data, not Python classes"),
                      ("path", "a USD for Isaac Sim; robocfg loads the URDF"),
@@ -120,7 +128,7 @@ def map_interndata(doc: YamlDocument, their: InterndataRobot, urdf: Urdf) -> Map
                      ("solver_velocity_iteration_count", "PhysX only; PyBullet has one solver iteration count"),
                      ("stabilization_threshold", "PhysX only")):
         if key in doc.data:
-            out.dropped.append((key, why))
+            out.dropped.append(Dropped(key, why))
     errors = [p for p in m.problems if p.severity == "error"]
     if errors:
         raise ConfigError(m.problems)
@@ -171,7 +179,7 @@ def _map_arm(m: _Mapper, out: Mapped, i: int, side: str, name: str) -> dict[str,
         followers = [j for j in grip if j in _followers(urdf, grip)]
         leaders = [j for j in grip if j not in followers]
         if followers:
-            out.dropped.append((f"{side}_gripper_indices", f"{followers} follow {leaders} through URDF <mimic> tags; "
+            out.dropped.append(Dropped(f"{side}_gripper_indices", f"{followers} follow {leaders} through URDF <mimic> tags; "
                                 "robocfg drives the leader and gears the followers"))
         home = getattr(t, f"{side}_gripper_home")
         gripper: dict[str, Any] = {"type": "parallel", "joints": leaders}
