@@ -14,7 +14,7 @@ QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print only the re
 StrictOpt = Annotated[bool, typer.Option("--strict", help="Treat warnings as errors.")]
 RobotOpt = Annotated[str | None, typer.Option("--robot", "-r", help="Robot name or YAML path (replaces the task's first robot).")]
 GuiOpt = Annotated[bool, typer.Option("--gui", help="Open the PyBullet GUI instead of running headless.")]
-RecordOpt = Annotated[Path | None, typer.Option("--record", help="Save pictures: .gif (animation) or .png (last frame).", dir_okay=False)]
+RecordOpt = Annotated[Path | None, typer.Option("--record", help="Save pictures: .gif or .mp4 (animation), .png (last frame), *sheet.png (key frame per phase).", dir_okay=False)]
 SeedOpt = Annotated[int | None, typer.Option("--seed", min=0, help="Random seed, >= 0 (overrides the task's sim.seed).")]
 
 

@@ -104,10 +104,9 @@ def run_pick_place(
 
 def _recorder_factory(path: Path):
     def make(world):
-        from robocfg.sim.record import CameraView, Recorder
+        from robocfg.sim.record import Recorder
 
-        return Recorder(world, path, fps=12.0, camera=CameraView(target=(0.35, 0.05, 0.15), distance=1.3,
-                                                                  yaw_deg=30.0, pitch_deg=-30.0))
+        return Recorder(world, path, fps=12.0)  # camera fitted to the robot, the scene and the place target
 
     return make
 

@@ -40,8 +40,9 @@ class GraspRecorder(Recorder):
             x0, x1 = boxes.finger_depth()
             self.finger_length = max(0.01, x1 - x0)
         if self.animate:  # hold the planning frame a moment (same picture, three frames)
-            frame = self.render()
-            self.frames.extend([frame] * min(3, max(0, self.max_frames - len(self.frames))))
+            frame, info = self.render(), self.info()
+            for _ in range(3):
+                self.keep(frame, info)
 
     def render(self) -> np.ndarray:
         frame = super().render()

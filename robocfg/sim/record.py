@@ -1,9 +1,10 @@
 """Pictures of a world with PyBullet's TinyRenderer (CPU, works headless).
 
 ``Recorder(world, "out.gif", fps=15)``: call ``maybe_capture()`` after every ``world.step()``; a frame
-is taken whenever ``fps`` says one is due (simulated time). ``save()`` writes an animated GIF
-(``.gif``) or the last frame (``.png``). Camera: an orbit camera (``target`` point in world m,
-``distance`` m, ``yaw_deg``/``pitch_deg`` as in PyBullet's debug camera).
+is rendered only when ``fps`` says one is due (simulated time). ``save()`` writes an animated GIF
+(``.gif``), an MP4 (``.mp4``), the last frame (``.png``) or a contact sheet (``*sheet.png``).
+Camera: fitted to the scene by default; else an orbit camera (``target`` point in world m,
+``distance`` m, ``yaw_deg``/``pitch_deg`` as in PyBullet's debug camera) or an ``eye`` point.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 import pybullet as p
 
 from robocfg.errors import RobocfgError
+from robocfg.sim.record_overlay import FrameInfo, Marker, contact_sheet, draw_markers, draw_status
 
 
 @dataclass(frozen=True)
@@ -33,22 +35,39 @@ class CameraView:
 
 @dataclass
 class Recorder:
-    """Frames of ``world`` at ``fps`` (simulated time) into ``path`` (.gif or .png)."""
+    """Frames of ``world`` at ``fps`` (simulated time) into ``path``.
+
+    ``path``: ``.gif`` (animation), ``.mp4`` (H.264 video), ``.png`` (the last frame), or a
+    ``.png`` whose name ends in ``sheet`` (``run_sheet.png``: a contact sheet of key frames, one
+    per phase). ``camera`` None: :func:`scene_camera` fits one to the robots and the task's bodies.
+    ``overlay``: a status bar (time, phase, gripper opening), the place target with its tolerance,
+    and a success/failure banner at the end. Runners call :meth:`set_phase` and :meth:`finish`.
+    """
 
     world: object
     path: Path | str
     fps: float = 10.0
     size: tuple[int, int] = (320, 240)
-    camera: CameraView = field(default_factory=CameraView)
+    camera: CameraView | None = None
     max_frames: int = 600
+    overlay: bool = True
     frames: list[np.ndarray] = field(default_factory=list, init=False)
+    infos: list[FrameInfo] = field(default_factory=list, init=False)
+    markers: list[Marker] = field(default_factory=list, init=False)
+    phase: str = field(default="", init=False)
+    result: tuple[bool, str] | None = field(default=None, init=False)
     _next_t: float = field(default=0.0, init=False)
 
     def __post_init__(self) -> None:
         self.path = Path(self.path)
-        if self.path.suffix.lower() not in (".gif", ".png"):
-            raise RobocfgError(f"--record needs a .gif or .png file name, got {self.path.name!r}")
-        self.animate = self.path.suffix.lower() == ".gif"
+        kind = self.path.suffix.lower()
+        if kind not in (".gif", ".png", ".mp4"):
+            raise RobocfgError(f"--record needs a .gif, .mp4 or .png file name, got {self.path.name!r}")
+        self.sheet = kind == ".png" and self.path.stem.lower().endswith("sheet")
+        self.animate = kind != ".png" or self.sheet
+        self.markers = task_markers(self.world)
+        if self.camera is None:
+            self.camera = scene_camera(self.world, self.size, self.markers)
 
     def view_projection(self) -> tuple[list[float], list[float]]:
         """PyBullet's (view, projection) matrices of the camera (column-major 16-lists)."""
@@ -59,21 +78,54 @@ class Recorder:
         return project(points, self.world.client, self.camera, self.size)
 
     def render(self) -> np.ndarray:
-        """One RGB frame (H, W, 3) uint8 from the current state."""
+        """One RGB frame (H, W, 3) uint8 from the current state (no status overlay)."""
         return render(self.world.client, self.camera, self.size)
 
-    def capture(self) -> None:
-        """Take a frame now (keeps only the last one when saving a .png)."""
-        frame = self.render()
+    def set_phase(self, name: str) -> None:
+        """Name the phase shown from the next frame on."""
+        self.phase = name
+
+    def finish(self, success: bool, reason: str = "") -> None:
+        """Mark the run's outcome: the last frame is re-taken with a SUCCESS/FAILED banner."""
+        self.result = (bool(success), reason)
+
+    def info(self) -> FrameInfo:
+        """Time, phase and first gripper's opening now."""
+        opening = None
+        robots = getattr(self.world, "robots", [])
+        if robots:
+            g = robots[0].arm().gripper
+            w = g.width() if g is not None and hasattr(g, "width") else None
+            opening = None if w is None else float(w)
+        return FrameInfo(float(getattr(self.world, "t", 0.0)), self.phase, opening)
+
+    def _decorated(self, frame: np.ndarray, info: FrameInfo, result=None) -> np.ndarray:
+        if not self.overlay:
+            return frame
+        from PIL import Image
+
+        img = Image.fromarray(frame)
+        draw_markers(img, self.markers, self.project)
+        draw_status(img, info, result)
+        return np.asarray(img)
+
+    def keep(self, frame: np.ndarray, info: FrameInfo | None = None) -> None:
+        """Store a rendered frame (with overlays) as the next one."""
+        info = info or self.info()
         if self.animate:
             if len(self.frames) < self.max_frames:
-                self.frames.append(frame)
+                self.frames.append(self._decorated(frame, info))
+                self.infos.append(info)
         else:
-            self.frames = [frame]
+            self.frames, self.infos = [self._decorated(frame, info)], [info]
+
+    def capture(self) -> None:
+        """Take a frame now (keeps only the last one when saving a single .png)."""
+        self.keep(self.render())
 
     def maybe_capture(self) -> None:
         """Capture if a frame is due at the world's current simulated time (PNG: cheap no-op
-        until ``save()``, which renders the final state)."""
+        until ``save()``, which renders the final state). Only kept frames are rendered."""
         if not self.animate:
             return
         if self.world.t + 1e-9 >= self._next_t:
@@ -81,18 +133,93 @@ class Recorder:
             self._next_t = self.world.t + 1.0 / self.fps
 
     def save(self) -> Path:
-        """Write the file (a .png renders the current state as its last frame). Returns the path."""
+        """Write the file (the current state is rendered as the last frame). Returns the path."""
         from PIL import Image
 
-        if not self.animate or not self.frames:
-            self.capture()
+        info = self.info()
+        last = self._decorated(self.render(), info, self.result)
+        if self.animate and len(self.frames) >= self.max_frames:
+            self.frames, self.infos = self.frames[:-1], self.infos[:-1]
+        self.frames.append(last)
+        self.infos.append(info)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        if self.animate:
-            imgs = [Image.fromarray(f) for f in self.frames]
-            imgs[0].save(self.path, save_all=True, append_images=imgs[1:], duration=int(1000 / self.fps), loop=0)
+        if self.sheet:
+            contact_sheet(self.frames, self.infos).save(self.path)
+        elif not self.animate:
+            Image.fromarray(last).save(self.path)
+        elif self.path.suffix.lower() == ".mp4":
+            write_mp4(self.path, self.frames, self.fps)
         else:
-            Image.fromarray(self.frames[-1]).save(self.path)
+            hold = [*self.frames, *([last] * max(1, int(self.fps)))]  # the result stays up ≈ 1 s
+            imgs = [Image.fromarray(f) for f in hold]
+            imgs[0].save(self.path, save_all=True, append_images=imgs[1:], duration=int(1000 / self.fps), loop=0)
         return self.path
+
+
+def write_mp4(path: Path, frames: list[np.ndarray], fps: float) -> None:
+    """H.264 MP4 (yuv420p, so every player opens it) with PyAV; odd sizes are padded by a pixel."""
+    from fractions import Fraction
+
+    import av
+
+    h, w = frames[0].shape[:2]
+    H, W = h + h % 2, w + w % 2
+    with av.open(str(path), mode="w") as out:
+        stream = out.add_stream("libx264", rate=Fraction(fps).limit_denominator(1000))
+        stream.width, stream.height, stream.pix_fmt = W, H, "yuv420p"
+        for f in [*frames, frames[-1]]:
+            if (h, w) != (H, W):
+                f = np.pad(f, ((0, H - h), (0, W - w), (0, 0)), mode="edge")
+            for packet in stream.encode(av.VideoFrame.from_ndarray(np.ascontiguousarray(f), format="rgb24")):
+                out.mux(packet)
+        for packet in stream.encode():
+            out.mux(packet)
+
+
+def task_markers(world) -> list[Marker]:
+    """The place target of a pick-place task (circle = success tolerance), if any."""
+    task = getattr(world, "task", None)
+    params = getattr(getattr(task, "config", None), "pick_place", None)
+    if params is None:
+        return []
+    x, y, _ = params.place_position
+    return [Marker("place target", (float(x), float(y), 0.001), float(params.success_tolerance))]
+
+
+def _work_boxes(world) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Where a pick-place hand goes: above the object's start and the place target (the object
+    is spawned after the recorder is made, and the hand rises above both)."""
+    task = getattr(world, "task", None)
+    params = getattr(getattr(task, "config", None), "pick_place", None)
+    if params is None:
+        return []
+    out = []
+    for x, y, z in (params.object.position, params.place_position):
+        out.append((np.array([x - 0.06, y - 0.06, 0.0]), np.array([x + 0.06, y + 0.06, z + 0.25])))
+    return out
+
+
+def scene_camera(world, size: tuple[int, int] = (320, 240), markers=(), direction=(1.0, -0.8, 0.75),
+                 margin: float = 1.1) -> CameraView:
+    """A camera fitted (see :func:`fit_camera`) to the box around every robot and body of the
+    world except the ground, and the markers: a tabletop arm and a KR210 on its pedestal both
+    fill the frame. The robot's box is taken at its current (start) pose."""
+    c = world.client
+    skip = {getattr(world, "bodies", {}).get("ground")}
+    boxes = []
+    for i in range(p.getNumBodies(physicsClientId=c)):
+        bid = p.getBodyUniqueId(i, physicsClientId=c)
+        if bid in skip:
+            continue
+        for li in range(-1, p.getNumJoints(bid, physicsClientId=c)):
+            boxes.append(p.getAABB(bid, li, physicsClientId=c))
+    for m in markers:
+        r = np.array([m.radius, m.radius, 0.0])
+        boxes.append((np.asarray(m.position) - r, np.asarray(m.position) + r))
+    boxes += _work_boxes(world)
+    lo = np.min([b[0] for b in boxes], axis=0)
+    hi = np.max([b[1] for b in boxes], axis=0)
+    return fit_camera(lo, hi, direction, aspect=size[0] / size[1], margin=margin)
 
 
 def view_projection(client: int, camera: CameraView, size: tuple[int, int]) -> tuple[list[float], list[float]]:

@@ -9,12 +9,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw, ImageFont
+from PIL import Image, ImageDraw
 
+from robocfg.sim.record_overlay import font
 from robocfg.viewer.frames import BOX_EDGES, ArmFrames
 
 AXIS_COLORS = ((225, 30, 30), (20, 160, 20), (30, 70, 230))  # x, y, z
@@ -24,16 +23,6 @@ COLLISION_COLOR = (0, 170, 190)
 TEXT_COLOR = (10, 10, 10)
 
 Projector = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # world (N, 3) → pixels (N, 2), in front (N,)
-
-
-@lru_cache(maxsize=16)
-def font(size: int) -> ImageFont.ImageFont | ImageFont.FreeTypeFont:
-    """DejaVu Sans (shipped with matplotlib; it has the −, →, × glyphs the labels use) at ``size``
-    px, else Pillow's bundled font."""
-    import matplotlib
-
-    path = Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"
-    return ImageFont.truetype(str(path), size) if path.is_file() else ImageFont.load_default(size=size)
 
 
 @dataclass
