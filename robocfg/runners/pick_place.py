@@ -125,7 +125,8 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
                 failed, reason = exc.phase, exc.reason
                 sm.close_phase(False, reason)
             if recorder is not None:
-                recorder.finish(failed is None, "" if failed is None else f"{failed}: {reason}")
+                if hasattr(recorder, "finish"):  # record= may be any object with save()
+                    recorder.finish(failed is None, "" if failed is None else f"{failed}: {reason}")
                 recorder.save()
             res = sm.result(failed, reason)
             if sm.sink is not None:
@@ -240,7 +241,7 @@ class _StateMachine:
             self.close_phase(True)
         self._phase = (name, self.world.t)
         self.mover.phase, self.mover.timeout = name, getattr(self.params.timeouts, name)
-        if self.recorder is not None:
+        if hasattr(self.recorder, "set_phase"):
             self.recorder.set_phase(name)
         n = len(self.phases) + 1
         self.log(f"Phase {n}: {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
