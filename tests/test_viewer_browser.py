@@ -27,7 +27,7 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-def _wait(cond, timeout: float = 20.0, what: str = "condition") -> None:
+def _wait(cond, timeout: float = 60.0, what: str = "condition") -> None:
     end = time.monotonic() + timeout
     while not cond():
         if time.monotonic() > end:
@@ -91,8 +91,8 @@ def test_page_shows_robot_and_slider_moves_a_link(viewer, browser, tmp_path):
     try:
         page.goto(viewer.url)
         _wait(lambda: len(viewer.server.get_clients()) == 1, what="the page to connect")
-        page.wait_for_selector("canvas", timeout=20000)
-        page.get_by_text("panda_joint1").first.wait_for(timeout=20000)  # the sliders arrived
+        page.wait_for_selector("canvas", timeout=60000)
+        page.get_by_text("panda_joint1").first.wait_for(timeout=60000)  # the sliders arrived
         time.sleep(2.0)  # let the client load the meshes and draw
         before = _scene_pixels(page)
         assert before.std() > 10, "the 3-D view shows something"
@@ -135,7 +135,7 @@ def test_saving_a_broken_yaml_shows_its_errors_in_the_page(tmp_path, browser):
         line = next(i for i, s in enumerate(text.splitlines(), 1) if "ee_link: panda_hand" in s)
         assert v.errors[0].startswith(f"{path}:{line}:")
         assert "did you mean 'panda_hand'" in v.errors[0]
-        page.get_by_text("is invalid").first.wait_for(timeout=20000)
+        page.get_by_text("is invalid").first.wait_for(timeout=60000)
         assert page.get_by_text("panda_hnd").count() >= 1
         path.write_text(text)
         _wait(lambda: not v.errors and v.robots, what="the reload after the fix")
