@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from _cli import ROOT, run_main
 
 GOLDEN = Path(__file__).parent / "golden"

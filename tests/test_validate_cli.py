@@ -144,7 +144,8 @@ def test_robots_lists_panda(tmp_path, capsys, monkeypatch):
     assert code == 0
     assert "panda" in out and "parallel" in out
     rows = {r["name"]: r for r in json.loads((tmp_path / "robots.json").read_text())}
-    assert rows["panda"]["dof"] == 7 and rows["panda"]["gripper"] == "parallel"
+    assert rows["panda"]["dof"] == 7 and rows["panda"]["grippers"] == ["parallel"] and rows["panda"]["valid"]
+    assert rows["dual_panda"]["arms"] == ["left", "right"] and rows["dual_panda"]["grippers"] == ["parallel", "parallel"]
 
 
 def test_robots_finds_robocfg_path(tmp_path, capsys, monkeypatch):

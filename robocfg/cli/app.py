@@ -48,6 +48,9 @@ def _root(
 ) -> None:
     if debug:
         os.environ["ROBOCFG_DEBUG"] = "1"
+    from robocfg.cli import common
+
+    common._stdout_taken = False  # set again by ``--json -`` while this command line is parsed
 
 
 app.command("validate")(validate.validate)

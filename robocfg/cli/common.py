@@ -9,12 +9,60 @@ from typing import Annotated, Any
 
 import typer
 
-JsonOpt = Annotated[Path | None, typer.Option("--json", help="Write a JSON report to this path.", dir_okay=False)]
+STDOUT = Path("-")  # ``--json -``: the report goes to standard output, the human summary to stderr
+_stdout_taken = False
+
+
+def _output_path(raw: str, option: str, suffixes: tuple[str, ...]) -> Path:
+    """Check an output path when the command line is parsed, i.e. before any simulation: its
+    folder exists and is writable, it is no folder itself (``out/`` included), it ends in one of
+    ``suffixes``. ``-`` (only for ``--json``) is standard output."""
+    global _stdout_taken
+    if raw == "-" and option == "--json":
+        _stdout_taken = True
+        return STDOUT
+    path = Path(raw)
+    if raw.endswith(("/", os.sep)) or path.is_dir():
+        raise typer.BadParameter(f"{raw!r} is a folder; give a file name", param_hint=option)
+    if suffixes and path.suffix.lower() not in suffixes:
+        raise typer.BadParameter(f"{raw!r} must end in {' or '.join(suffixes)}", param_hint=option)
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise typer.BadParameter(f"folder {str(parent)!r} does not exist", param_hint=option)
+    if not _can_create_in(parent) or (path.exists() and not os.access(path, os.W_OK)):
+        raise typer.BadParameter(f"{raw!r} is not writable", param_hint=option)
+    return path
+
+
+def _can_create_in(folder: Path) -> bool:
+    """Whether a file can be created in ``folder`` (tried, since permission bits do not tell for
+    root or for special file systems); the report is later written there the same way."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            return True
+    except OSError:
+        return False
+
+
+def _json_path(raw: str) -> Path:
+    return _output_path(raw, "--json", (".json",))
+
+
+def _record_path(raw: str) -> Path:
+    return _output_path(raw, "--record", (".gif", ".mp4", ".png"))
+
+
+JsonOpt = Annotated[Path | None, typer.Option("--json", parser=_json_path, metavar="PATH",
+                                              help="Write a JSON report to this .json file ('-': standard output).")]
 QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print only the result.")]
 StrictOpt = Annotated[bool, typer.Option("--strict", help="Treat warnings as errors.")]
 RobotOpt = Annotated[str | None, typer.Option("--robot", "-r", help="Robot name or YAML path (replaces the task's first robot).")]
 GuiOpt = Annotated[bool, typer.Option("--gui", help="Open the PyBullet GUI instead of running headless.")]
-RecordOpt = Annotated[Path | None, typer.Option("--record", help="Save pictures: .gif or .mp4 (animation), .png (last frame), *sheet.png (key frame per phase).", dir_okay=False)]
+RecordOpt = Annotated[Path | None, typer.Option("--record", parser=_record_path, metavar="PATH",
+                                                help="Save pictures: .gif or .mp4 (animation), .png (last frame), "
+                                                     "*sheet.png (key frame per phase).")]
 SeedOpt = Annotated[int | None, typer.Option("--seed", min=0, help="Random seed, >= 0 (overrides the task's sim.seed).")]
 
 
@@ -27,19 +75,44 @@ def console(stderr: bool = False):
 
     from rich.console import Console
 
+    stderr = stderr or _stdout_taken  # ``--json -`` owns standard output
     stream = sys.stderr if stderr else sys.stdout
     width = None if stream.isatty() else 160
     return Console(stderr=stderr, highlight=False, soft_wrap=True, width=width)
 
 
 def write_json(path: Path | None, payload: Any) -> None:
-    """Write ``payload`` (a pydantic model, dataclass or plain data) as indented JSON."""
+    """Write ``payload`` (a pydantic model, dataclass or plain data) as indented JSON.
+
+    ``-`` writes to standard output. A file is written atomically: a temporary file in the same
+    folder, flushed, then renamed over ``path``, so a reader (or a second writer, or a crash) never
+    sees half a report and an older report is either kept whole or replaced whole."""
+    import sys
+    import tempfile
+
     if path is None:
         return
     if hasattr(payload, "model_dump"):
         payload = payload.model_dump(mode="json")
+    text = json.dumps(payload, indent=2, sort_keys=False, default=_default) + "\n"
+    if path == STDOUT:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(payload, indent=2, sort_keys=False, default=_default) + "\n")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 def _default(o: Any) -> Any:

@@ -22,10 +22,14 @@ def robots(json_path: JsonOpt = None) -> None:
             r = load_robot(path)
             arms = [a.name for a in r.config.arms]
             dof = sum(len(r.arm_joints(a)) for a in r.config.arms)
-            grip = ",".join(a.gripper.type if a.gripper else "none" for a in r.config.arms)
+            grippers = [a.gripper.type if a.gripper else "none" for a in r.config.arms]
+            problems = 0
         except ConfigError as exc:
-            arms, dof, grip = [], 0, f"invalid ({len(exc.problems)} problems)"
-        rows.append({"name": name, "arms": arms, "dof": dof, "gripper": grip, "source": str(path)})
-        table.add_row(name, ",".join(arms), str(dof), grip, str(path))
+            arms, dof, grippers, problems = [], 0, [], len(exc.problems)
+        # one gripper type per arm, in the order of ``arms``; ``problems``: errors in an invalid YAML
+        rows.append({"name": name, "arms": arms, "dof": dof, "grippers": grippers, "valid": problems == 0,
+                     "problems": problems, "source": str(path)})
+        table.add_row(name, ",".join(arms), str(dof),
+                      ",".join(grippers) if not problems else f"invalid ({problems} problems)", str(path))
     console().print(table)
     write_json(json_path, rows)

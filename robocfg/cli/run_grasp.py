@@ -42,11 +42,18 @@ def run_grasp(
     Exit 0 when the lift success rate reaches --min-success, 1 otherwise (no object points in the
     workspace, no feasible grasp, or the object was not held). --record draws the candidate grasps.
     """
+    from robocfg.cli.episodes import (
+        check_record_episode,
+        interrupted_line,
+        progress_bar,
+        stop_on_signals,
+    )
     from robocfg.errors import ConfigError, Problem, RunFailed
     from robocfg.sim.quiet import quiet_import
 
     if save_cloud is not None and save_cloud.suffix.lower() not in (".npz", ".ply"):
         raise ConfigError([Problem("--save-cloud", None, None, "", f"needs a .npz or .ply file name, got {save_cloud.name!r}")])
+    check_record_episode(record_episode, episodes, record is not None)
     quiet_import()
     from robocfg.runners.grasp import EpisodeFailed
     from robocfg.runners.grasp import run_grasp as run
@@ -60,33 +67,18 @@ def run_grasp(
     saver = _cloud_saver(save_cloud) if save_cloud else None
     log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
     try:
-        if episodes > 1 and not quiet:
-            from rich.progress import (
-                BarColumn,
-                MofNCompleteColumn,
-                Progress,
-                TextColumn,
-                TimeRemainingColumn,
-            )
-
-            with Progress(TextColumn("grasp"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[ok]}"),
-                          TimeRemainingColumn(), console=err, transient=True) as bar:
-                tid = bar.add_task("episodes", total=episodes, ok="")
-                done = {"ok": 0}
-
-                def tick(res) -> None:
-                    done["ok"] += res.success
-                    bar.update(tid, advance=1, ok=f"{done['ok']} lifted")
-
-                report, timing = run(checked, episodes, seed, arm, recorder, record_episode, log, saver, tick)
-        else:
-            report, timing = run(checked, episodes, seed, arm, recorder, record_episode, log, saver)
+        with stop_on_signals() as stop, progress_bar("grasp", episodes, "lifted", episodes > 1 and not quiet) as tick:
+            report, timing = run(checked, episodes, seed, arm, recorder, record_episode, log, saver, tick,
+                                 should_stop=stop)
     except EpisodeFailed as exc:
         raise RunFailed(exc.phase, exc.reason) from None
     for w in report.warnings:
         err.print(f"warning: {w}", markup=False)
     write_json(json_path, report)
     _print(report, timing, record, save_cloud, quiet)
+    if report.interrupted:
+        err.print(interrupted_line(stop, len(report.episodes), episodes, json_path), markup=False)
+        return 130
     return 0 if report.summary.success_rate >= min_success else 1
 
 
@@ -111,14 +103,16 @@ def _cloud_saver(path: Path):
 
 
 def _print(report, timing, record, save_cloud, quiet: bool) -> None:
+    from robocfg.cli.episodes import failure_lines
+
     out = console()
     s = report.summary
     failed = [e for e in report.episodes if not e.success]
     if quiet:
         out.print(f"{'ok' if not failed else 'failed'}: {report.robot} lifted {s.successes}/{s.episodes} "
                   f"({s.success_rate:.1%}), planning median {timing.median_planning:.2f} s", markup=False)
-        for e in failed[:3]:
-            out.print(f"episode {e.index} ({e.object}): {e.failed_phase}: {e.reason}", markup=False)
+        for line in failure_lines(report.episodes):
+            out.print(f"  {line}", markup=False)
         return
     rows = [("episodes", str(s.episodes)),
             ("lift success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%}); first attempt {s.first_attempt_rate:.1%}"),
@@ -139,9 +133,10 @@ def _print(report, timing, record, save_cloud, quiet: bool) -> None:
     if save_cloud:
         rows.append(("cloud", str(save_cloud)))
     out.print(key_value_table(f"run grasp: {report.robot} (arm {report.arm}), seed {report.seed}", rows))
-    for e in failed[:20]:
-        out.print(f"[red]episode {e.index} ({e.object}, seed {e.seed}) failed[/red]: {e.failed_phase}: {e.reason}", highlight=False)
-    if len(failed) > 20:
-        out.print(f"... and {len(failed) - 20} more failures (see --json)")
+    for line in failure_lines(report.episodes):
+        out.print(f"[red]failed[/red] {line}", highlight=False)
+    if failed:
+        out.print(f"failed episodes: {', '.join(f'{e.index} ({e.object})' for e in failed[:20])}"
+                  f"{' ...' if len(failed) > 20 else ''} (seeds and details in --json)")
     if not failed:
         out.print("[green]ok[/green]")

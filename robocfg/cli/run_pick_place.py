@@ -55,8 +55,15 @@ def run_pick_place(
     the task's cameras) and the kept ones are written as a LeRobot v3.0 or robomimic HDF5 dataset;
     `robocfg dataset replay` re-simulates an episode from those actions.
     """
+    from robocfg.cli.episodes import (
+        check_record_episode,
+        interrupted_line,
+        progress_bar,
+        stop_on_signals,
+    )
     from robocfg.sim.quiet import quiet_import
 
+    check_record_episode(record_episode, episodes, record is not None)
     quiet_import()
     from robocfg.runners.pick_place import run_pick_place as run
 
@@ -72,33 +79,18 @@ def run_pick_place(
     sink = dataset_sink(dataset, dataset_format, dataset_fps, keep, checked, run_seed, arm, robot,
                         pick_place_instruction(checked.config.pick_place))
     log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
-    if episodes > 1 and not quiet:
-        from rich.progress import (
-            BarColumn,
-            MofNCompleteColumn,
-            Progress,
-            TextColumn,
-            TimeRemainingColumn,
-        )
-
-        with Progress(TextColumn("pick-place"), BarColumn(), MofNCompleteColumn(), TextColumn("{task.fields[ok]}"),
-                      TimeRemainingColumn(), console=console(stderr=True), transient=True) as bar:
-            tid = bar.add_task("episodes", total=episodes, ok="")
-            done = {"ok": 0}
-
-            def tick(res) -> None:
-                done["ok"] += res.success
-                bar.update(tid, advance=1, ok=f"{done['ok']} placed")
-
-            report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, tick, sink=sink)
-    else:
-        report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, sink=sink)
+    with stop_on_signals() as stop, progress_bar("pick-place", episodes, "placed", episodes > 1 and not quiet) as tick:
+        report, timing = run(checked, episodes, seed, arm, gui, recorder, record_episode, log, tick, sink=sink,
+                             should_stop=stop)
     written = sink.close() if sink is not None else None
     write_json(json_path, report)
     _print(report, timing, record, quiet)
     if written is not None and not quiet:
         out.print(f"dataset ({written.format}): {written.episodes_kept}/{written.episodes_run} episodes kept, "
                   f"{written.frames} frames → {written.path}", markup=False)
+    if report.interrupted:
+        console(stderr=True).print(interrupted_line(stop, len(report.episodes), episodes, json_path), markup=False)
+        return 130
     return 0 if report.summary.success_rate >= min_success else 1
 
 
@@ -112,12 +104,16 @@ def _recorder_factory(path: Path):
 
 
 def _print(report, timing, record, quiet: bool) -> None:
+    from robocfg.cli.episodes import failure_lines
+
     out = console()
     s = report.summary
     failed = [e for e in report.episodes if not e.success]
     if quiet:
         out.print(f"{'ok' if not failed else 'failed'}: {report.robot} placed {s.successes}/{s.episodes} "
                   f"({s.success_rate:.1%}), {s.mean_sim_time:.2f} s simulated per episode", markup=False)
+        for line in failure_lines(report.episodes):
+            out.print(f"  {line}", markup=False)
         return
     rows = [("episodes", str(s.episodes)), ("success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%})"),
             ("failures by phase", ", ".join(f"{k}: {v}" for k, v in s.failures_by_phase.items()) or "none"),
@@ -129,9 +125,10 @@ def _print(report, timing, record, quiet: bool) -> None:
     if record:
         rows.append(("record", str(record)))
     out.print(key_value_table(f"run pick-place: {report.robot} (arm {report.arm}), seed {report.seed}", rows))
-    for e in failed[:20]:
-        out.print(f"[red]episode {e.index} (seed {e.seed}) failed[/red]: {e.failed_phase}: {e.reason}")
-    if len(failed) > 20:
-        out.print(f"... and {len(failed) - 20} more failures (see --json)")
+    for line in failure_lines(report.episodes):
+        out.print(f"[red]failed[/red] {line}")
+    if failed:
+        out.print(f"failed episodes: {', '.join(str(e.index) for e in failed[:20])}"
+                  f"{' ...' if len(failed) > 20 else ''} (seeds and details in --json)")
     if not failed:
         out.print("[green]ok[/green]")

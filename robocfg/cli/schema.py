@@ -11,18 +11,20 @@ import typer
 
 
 def schema(
-    kind: Annotated[str, typer.Argument(help="robot or task")],
+    kind: Annotated[str, typer.Argument(help="robot, task, or a run report: report-pick-place, report-grasp")],
     output: Annotated[Path | None, typer.Option("-o", "--output", help="Write to this file instead of stdout.")] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output file.")] = False,
     markdown: Annotated[bool, typer.Option("--markdown", help="Field reference tables (Markdown) instead of JSON Schema; "
                                            "with -o, replaces only the generated block of an existing document.")] = False,
 ) -> None:
-    """Print the JSON Schema of robot or task YAMLs (for yaml-language-server)."""
+    """Print the JSON Schema of robot or task YAMLs (for yaml-language-server), or of a run's --json report."""
     from robocfg.errors import NotFound
 
-    if kind not in ("robot", "task"):
-        raise NotFound("schema kind", kind, ["robot", "task"])
-    if markdown:
+    if kind not in ("robot", "task", *REPORTS):
+        raise NotFound("schema kind", kind, ["robot", "task", *REPORTS])
+    if kind in REPORTS:
+        text = json.dumps(report_schema(kind), indent=2) + "\n"
+    elif markdown:
         text = markdown_text(kind)  # type: ignore[arg-type]
         if output is not None and output.exists():
             from robocfg.cli.schema_markdown import replace_block
@@ -42,6 +44,25 @@ def schema(
         raise RobocfgError(f"{output} exists; use --force to overwrite it")
     output.parent.mkdir(parents=True, exist_ok=True)
     output.write_text(text)
+
+
+REPORTS = ("report-pick-place", "report-grasp")
+
+
+def report_schema(kind: str) -> dict:
+    """JSON Schema of a ``run`` command's ``--json`` report, from its typed report dataclass."""
+    from pydantic import TypeAdapter
+
+    from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+
+    if kind == "report-pick-place":
+        from robocfg.runners.pick_place_report import PickPlaceReport as Report
+    else:
+        from robocfg.runners.grasp_report import GraspReport as Report  # type: ignore[assignment]
+    out = TypeAdapter(Report).json_schema(mode="serialization")
+    out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    out["title"] = f"robocfg run {kind.removeprefix('report-')} --json report (schema_version {REPORT_SCHEMA_VERSION})"
+    return out
 
 
 def json_schema(kind: Literal["robot", "task"]) -> dict:

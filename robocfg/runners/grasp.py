@@ -85,11 +85,13 @@ def episode_setups(params: GraspParams, seed: int, episodes: int) -> list[Episod
 
 def run_grasp(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm: str | None = None,
               record=None, record_episode: int = 0, log: Log | None = None, save_cloud=None,
-              on_episode: Callable[[GraspEpisode], None] | None = None) -> tuple[GraspReport, GraspTiming]:
+              on_episode: Callable[[GraspEpisode], None] | None = None,
+              should_stop: Callable[[], bool] | None = None) -> tuple[GraspReport, GraspTiming]:
     """Run ``episodes`` episodes in one world (restored to the same snapshot before each).
 
     ``record``: ``world -> GraspRecorder`` used for episode ``record_episode``; ``save_cloud``:
-    ``Cloud -> None`` called with the first processed cloud; ``log``: phase log of episode 0.
+    ``Cloud -> None`` called with the first processed cloud; ``log``: phase log of episode 0;
+    ``should_stop``: asked before each episode, True ends the run with an ``interrupted`` report.
     """
     from robocfg.grasp.gripper_model import measure_gripper
     from robocfg.grasp.perception import camera_warnings
@@ -126,7 +128,11 @@ def run_grasp(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm
             boxes=boxes, timing=timing, save_cloud=save_cloud,
         )
         spawned: str | None = None
+        interrupted = False
         for setup in episode_setups(params, seed, episodes):
+            if should_stop is not None and should_stop():
+                interrupted = True
+                break
             t0 = time.perf_counter()
             if spawned is not None and spawned in world.bodies:
                 world.remove_body(spawned)
@@ -143,7 +149,7 @@ def run_grasp(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm
                 on_episode(res)
     timing.wall_time = time.perf_counter() - t_all
     report = GraspReport(task=str(task.path), robot=robot.config.name, arm=arm_cfg.name, seed=seed,
-                         summary=summarise(results), episodes=results, warnings=warnings)
+                         summary=summarise(results), episodes=results, warnings=warnings, interrupted=interrupted)
     return report, timing
 
 
@@ -324,7 +330,8 @@ class _Episode:
         chosen = self.attempts[-1].candidate["score"] if self.attempts else None
         return GraspEpisode(
             index=s.index, seed=s.seed, object=b.name,
-            object_start=[round(b.position[0], 6), round(b.position[1], 6), round(math.degrees(s.yaw), 4)],
+            object_start=[round(float(v), 6) for v in b.position],
+            object_start_yaw_deg=round(math.degrees(s.yaw), 4),
             success=failed is None and bool(self.attempts) and self.attempts[-1].success,
             first_attempt_success=bool(self.attempts) and self.attempts[0].success,
             failed_phase=failed, reason=reason, object_points=self.n_points,

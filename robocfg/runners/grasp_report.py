@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+
 
 @dataclass
 class AttemptRecord:
@@ -21,13 +23,15 @@ class AttemptRecord:
 
 @dataclass
 class GraspEpisode:
-    """One episode. ``object_start``: x, y (m), yaw (deg); ``rejected``: candidate counts per
+    """One episode. ``object_start``: x, y, z (m) where the object was spawned, ``object_start_yaw_deg``
+    the yaw added by the randomisation; ``rejected``: candidate counts per
     rejection reason in the first plan; ``lift_rise``: how far the object rose (m)."""
 
     index: int
     seed: int
     object: str
     object_start: list[float]
+    object_start_yaw_deg: float
     success: bool
     first_attempt_success: bool
     failed_phase: str | None
@@ -55,6 +59,10 @@ class GraspSummary:
 
 @dataclass
 class GraspReport:
+    """The ``--json`` report. ``interrupted``: the run was stopped (SIGINT/SIGTERM) and
+    ``episodes`` holds only the episodes that finished."""
+
+    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)
     task: str
     robot: str
     arm: str
@@ -62,6 +70,7 @@ class GraspReport:
     summary: GraspSummary
     episodes: list[GraspEpisode]
     warnings: list[str] = field(default_factory=list)
+    interrupted: bool = False
 
 
 @dataclass

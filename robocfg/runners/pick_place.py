@@ -79,13 +79,15 @@ def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[Ep
 def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm: str | None = None,
                    gui: bool = False, record=None, record_episode: int = 0, log: Log | None = None,
                    on_episode: Callable[[EpisodeResult], None] | None = None,
-                   sink=None) -> tuple[PickPlaceReport, PickPlaceTiming]:
+                   sink=None, should_stop: Callable[[], bool] | None = None) -> tuple[PickPlaceReport, PickPlaceTiming]:
     """Run ``episodes`` episodes in one world, restored to the same snapshot before each; returns
     the report (deterministic for a seed) and wall times.
 
     ``record`` is a callable ``world -> Recorder`` used for episode ``record_episode``; ``log``
     receives the phase log of episode 0. ``sink`` (a :class:`robocfg.datasets.sink.DatasetSink`)
     records every episode; its command gate then stands between the state machine and the drives.
+    ``should_stop`` is asked before each episode; once it answers True the run ends and the report
+    (of the finished episodes) says ``interrupted``.
     """
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import limits_from_robot
@@ -109,7 +111,11 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
                                                            acceleration_scale=params.speed_scale)),
             _reactive_drive(robot, world, arm_cfg.name, params),
         )
+        interrupted = False
         for setup in episode_setups(params, seed, episodes):
+            if should_stop is not None and should_stop():
+                interrupted = True
+                break
             t0, physics0 = time.perf_counter(), world.physics_seconds
             if setup.body.name in world.bodies:
                 world.remove_body(setup.body.name)
@@ -139,7 +145,8 @@ def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None
     timing.wall_time = time.perf_counter() - t_all
     report = PickPlaceReport(task=str(task.path), robot=robot.config.name, arm=arm_cfg.name, seed=seed,
                              summary=summarise(results), episodes=results,
-                             warnings=[w.format() for w in task.warnings] + _reactive_warnings(tools.reactive))
+                             warnings=[w.format() for w in task.warnings] + _reactive_warnings(tools.reactive),
+                             interrupted=interrupted)
     return report, timing
 
 
@@ -362,7 +369,8 @@ class _StateMachine:
         err = float(np.linalg.norm(pos[:2] - s.place_xy))
         return EpisodeResult(
             index=s.index, seed=s.seed, success=failed is None, failed_phase=failed, reason=reason,
-            object_start=[round(b.position[0], 6), round(b.position[1], 6), round(math.degrees(s.yaw), 4)],
+            object_start=[round(float(v), 6) for v in b.position],
+            object_start_yaw_deg=round(math.degrees(s.yaw), 4),
             place_target=[round(float(v), 6) for v in s.place_xy],
             object_final=[round(float(v), 6) for v in pos],
             place_error=round(err, 6), tilt_deg=round(self._tilt(quat), 4),

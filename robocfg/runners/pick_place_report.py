@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+
 PHASES = ("pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
 
 
@@ -28,9 +30,10 @@ class EpisodeResult:
     success: bool
     failed_phase: str | None
     reason: str
-    object_start: list[float]  # x, y, yaw_deg
-    place_target: list[float]  # x, y
-    object_final: list[float]  # x, y, z
+    object_start: list[float]  # x, y, z (m): where the randomised object was spawned
+    object_start_yaw_deg: float  # its yaw about world z
+    place_target: list[float]  # x, y (m)
+    object_final: list[float]  # x, y, z (m)
     place_error: float | None  # horizontal distance (m)
     tilt_deg: float | None
     lift_rise: float | None  # how far the object rose during lift (m)
@@ -52,6 +55,10 @@ class PickPlaceSummary:
 
 @dataclass
 class PickPlaceReport:
+    """The ``--json`` report. ``interrupted``: the run was stopped (SIGINT/SIGTERM) and
+    ``episodes`` holds only the episodes that finished."""
+
+    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)
     task: str
     robot: str
     arm: str
@@ -59,6 +66,7 @@ class PickPlaceReport:
     summary: PickPlaceSummary
     episodes: list[EpisodeResult]
     warnings: list[str] = field(default_factory=list)
+    interrupted: bool = False
 
 
 @dataclass
