@@ -60,12 +60,22 @@ class NotFound(RobocfgError):
         super().__init__(f"unknown {kind} {name!r}{hint}; known: {listing}")
 
 
-class RunFailed(RobocfgError):
-    """A run that could not succeed: names the phase and the reason (exit 1)."""
+class PhaseFailed(RobocfgError):
+    """A phase of an episode could not be completed: its ``phase`` name (``approach``, ``lift``,
+    ``perception``...) and a one-line ``reason`` (``IK did not converge, residual 4.2 mm``).
+    The one (phase, reason) error: moves, episodes and whole runs raise it or a subclass."""
+
+    def __init__(self, phase: str, reason: str):
+        self.phase, self.reason = phase, reason
+        super().__init__(f"{phase}: {reason}")
+
+
+class RunFailed(PhaseFailed):
+    """A whole run that could not succeed (exit 1); ``report``: what it measured before failing."""
 
     def __init__(self, phase: str, reason: str, report: object | None = None):
-        self.phase, self.reason, self.report = phase, reason, report
-        super().__init__(f"{phase}: {reason}")
+        super().__init__(phase, reason)
+        self.report = report
 
 
 class PhysicsDiverged(RunFailed):

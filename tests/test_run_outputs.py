@@ -122,3 +122,14 @@ def test_quiet_failure_lines_count_each_distinct_reason():
     eps = [ep(0, "approach", "IK did not converge"), ep(1, None, "placed"),
            ep(2, "approach", "IK did not converge"), ep(3, "place", "object tilted 40.0°")]
     assert failure_lines(eps) == ["2 × approach: IK did not converge", "1 × place: object tilted 40.0°"]
+
+
+def test_one_phase_failed_error_for_moves_episodes_and_runs():
+    from robocfg.errors import PhaseFailed, PhysicsDiverged, RunFailed
+    from robocfg.motion.moves import MoveFailed
+    from robocfg.runners.grasp import EpisodeFailed
+
+    assert MoveFailed is PhaseFailed and EpisodeFailed is PhaseFailed
+    exc = PhysicsDiverged(1.25, "body 'cube' speed 90 m/s")
+    assert isinstance(exc, RunFailed) and isinstance(exc, PhaseFailed)
+    assert (exc.phase, exc.reason) == ("physics", "physics diverged at t = 1.250 s (body 'cube' speed 90 m/s)")

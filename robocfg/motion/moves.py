@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from robocfg.errors import PhaseFailed
 from robocfg.geometry import rotation_angle
 
 if TYPE_CHECKING:
@@ -44,12 +45,7 @@ def bound_ik_by_iterations(model: KinematicModel, iterations: int = IK_ITERATION
     model.solver().max_total_iter = iterations
 
 
-class MoveFailed(Exception):
-    """A phase could not be completed: ``phase`` name and a one-line ``reason``."""
-
-    def __init__(self, phase: str, reason: str):
-        self.phase, self.reason = phase, reason
-        super().__init__(f"{phase}: {reason}")
+MoveFailed = PhaseFailed  # the name the motion code raises; one (phase, reason) error for all
 
 
 @dataclass

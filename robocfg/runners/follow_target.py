@@ -24,6 +24,7 @@ from robocfg.config.commands import FollowObstacle, FollowTargetParams
 from robocfg.config.scene import Body
 from robocfg.errors import RunFailed
 from robocfg.geometry import euler_deg_to_quat_xyzw, rotation_angle
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
 CLEARANCE_QUERY = 0.5  # m: clearances beyond this are reported as this value
 SAMPLE_RATE = 60.0  # Hz of the samples kept in the result
@@ -50,6 +51,7 @@ class Stats:
 
 @dataclass
 class FollowTargetResult:
+    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
     task: str
     robot: str
     arm: str

@@ -23,7 +23,7 @@ from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import GraspParams, Limits
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
-from robocfg.errors import RobocfgError
+from robocfg.errors import PhaseFailed, RobocfgError
 from robocfg.geometry import rotation_angle
 from robocfg.grasp.antipodal import Candidate, PlannerSettings, PlanResult, plan_grasps
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
@@ -47,10 +47,7 @@ HALF_TURN = np.diag([1.0, -1.0, -1.0])  # about the approach axis: the same para
 ROLLING_FRICTION = 1e-3
 
 
-class EpisodeFailed(Exception):
-    def __init__(self, phase: str, reason: str):
-        self.phase, self.reason = phase, reason
-        super().__init__(f"{phase}: {reason}")
+EpisodeFailed = PhaseFailed  # perception or planning found nothing to try
 
 
 @dataclass(frozen=True)
@@ -205,9 +202,7 @@ class _Episode:
                     self.failed.append(cand.grasp)
                     failed, reason = exc.phase, exc.reason
                     self._recover()
-        except EpisodeFailed as exc:
-            failed, reason = exc.phase, exc.reason
-        except MoveFailed as exc:  # recovery itself failed
+        except PhaseFailed as exc:  # nothing to try (perception, planning), or recovery itself failed
             failed, reason = exc.phase, exc.reason
         return self._result(failed, reason)
 

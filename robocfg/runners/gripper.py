@@ -19,6 +19,7 @@ from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import GripperParams
 from robocfg.config.scene import Body
 from robocfg.errors import RobocfgError, RunFailed
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
 SETTLE_TIME = 0.25  # s
 SETTLE_TOL_FRACTION = 0.02  # of max_width − min_width, at least SETTLE_TOL_MIN
@@ -58,6 +59,7 @@ class HoldTest:
 
 @dataclass
 class GripperResult:
+    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
     task: str
     robot: str
     arm: str

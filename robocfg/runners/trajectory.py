@@ -19,6 +19,7 @@ import numpy as np
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import TrajectoryParams
 from robocfg.errors import RunFailed
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
 CHECK_RATE = 1000.0  # Hz: resampling rate of the limit check
 
@@ -36,6 +37,7 @@ class Samples:
 
 @dataclass
 class TrajectoryResult:
+    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
     task: str
     robot: str
     arm: str
