@@ -21,13 +21,15 @@ makes the episode reproducible.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar, Literal
+from typing import Any, Literal
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
 from robocfg import api
+from robocfg.config.task import PickPlaceTask
+from robocfg.errors import RobocfgError
 from robocfg.geometry import rotation_angle
 from robocfg.kinematics.frames import top_down_grasps
 from robocfg.sim.gripper import ParallelGripper
@@ -54,7 +56,7 @@ class RobotEnv(gym.Env):
     """Base class: world, IK, action handling, goal observation. Subclasses (``tasks.py``) say
     what the goal is, what is observed besides the TCP, and what counts as success."""
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 25}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 25}  # noqa: RUF012  (gymnasium's own instance attribute)
     uses_gripper = False
     uses_object = False
 
@@ -78,7 +80,9 @@ class RobotEnv(gym.Env):
         self.arm = self.world.robot.arm()
         self.gripper = self.arm.gripper
         self.step_time = self.substeps * self.world.dt
-        body = task.config.pick_place.object  # type: ignore[union-attr]  (a 5 cm, 0.1 kg cube)
+        if not isinstance(task.config, PickPlaceTask):
+            raise RobocfgError(f"the built-in pick_place task is of kind {task.config.task!r}")
+        body = task.config.pick_place.object  # the task's cube: 5 cm, 0.1 kg
         self.object, self.object_half_height = body.name, body.size[2] / 2
         if self.uses_object:
             self.world.add_body(body)
