@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from tests._cli import ROOT, run_main
-from tests._corpus import Case, all_cases, write
+from _cli import ROOT, run_main
+from _corpus import Case, all_cases, write
 
 CASES = all_cases()
 CORPUS_TIMES: dict[str, float] = {}
