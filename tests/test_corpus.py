@@ -15,7 +15,6 @@ import time
 from pathlib import Path
 
 import pytest
-
 from _cli import ROOT, run_main
 from _corpus import Case, all_cases, write
 
