@@ -105,3 +105,49 @@ def test_grasp_choice_avoids_a_far_ik_branch(monkeypatch):
     _placed(report, task)
     pre = report.episodes[0].phases[0]
     assert pre.name == "pre_grasp" and pre.t_end - pre.t_start < 4.0
+
+
+# ---- robots authored from published data (UR10e + 2F-140, ABB IRB 7600, NEURA MAiRA 7M) ----------
+
+
+def test_authored_ur10e_follows_the_published_dh_table():
+    """Zero pose: tool0 at (−a2 − a3, d4 + d6, d1 − d5) = (1.18425, 0.2907, 0.06085) m; the
+    tutorial's home points the gripper straight down."""
+    robot = load_robot(catalog.find("robots", "ur10e_robotiq_2f140"))
+    urdf = robot.urdf
+    np.testing.assert_allclose(urdf.link_pose("tool0", {})[:3, 3], [1.18425, 0.2907, 0.06085], atol=1e-9)
+    arm = robot.config.arm()
+    home = urdf.link_pose("tool0", dict(zip(arm.joints, arm.home, strict=True)))
+    assert home[:3, 2] @ [0.0, 0.0, -1.0] > 0.999  # approach axis down
+    masses = [ln.mass for ln in urdf.links.values() if ln.mass]
+    assert 33.0 < sum(masses) < 36.0  # UR10e 33.5 kg + 2F-140 ≈ 1 kg
+
+
+def test_2f140_strokes_140_mm_with_fingers_parallel():
+    """Close the 2F-140 in steps: the measured pad gap runs from 140 mm to ≈ 0 and each pad keeps
+    its orientation relative to the gripper body (the four-bar's mimic joints hold)."""
+    from robocfg.sim.world import World
+
+    task = load_task(catalog.find("tasks", "gripper_ur10e"))
+    with World(task) as world:
+        robot, g = world.robot, world.robot.arm().gripper
+        widths, tilt = [], 0.0
+        for s in np.linspace(1.0, 0.0, 8):
+            g.set_fraction(s)
+            world.step(round(0.4 / world.dt))
+            widths.append(g.width())
+            base = robot.link_pose("robotiq_2f140_base_link")[:3, :3]
+            for pad in ("left_inner_finger_pad", "right_inner_finger_pad"):
+                rel = base.T @ robot.link_pose(pad)[:3, :3]
+                tilt = max(tilt, math.acos(np.clip((np.trace(rel) - 1) / 2, -1, 1)))
+    assert widths[0] == pytest.approx(0.140, abs=1e-3)
+    assert widths[-1] < 0.002
+    assert np.all(np.diff(widths) < 0)
+    assert tilt < 0.01, f"a pad turned {tilt:.4f} rad"
+
+
+@pytest.mark.parametrize(("task_name", "robot"), [("pick_place_ur10e", None)])
+def test_authored_robot_runs_its_own_pick_place(task_name, robot):
+    task = load_task(catalog.find("tasks", task_name), robot_override=robot)
+    report, _ = run_pick_place(task, episodes=1, seed=1)
+    _placed(report, task)
