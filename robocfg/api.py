@@ -10,7 +10,7 @@ with ``FILE:LINE:COL`` problems), ``NotFound`` (unknown name, lists the known on
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -19,6 +19,7 @@ from robocfg.config import catalog
 if TYPE_CHECKING:
     from robocfg.checks.robot import CheckedRobot
     from robocfg.checks.task import CheckedTask
+    from robocfg.engine import RunOptions
     from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
     from robocfg.sim.world import World
@@ -44,24 +45,30 @@ def load_task(name_or_path: str | Path, robot: str | None = None,
                  overrides=overrides)
 
 
-def _runners() -> dict[str, Callable[..., Any]]:
-    from robocfg.runners.follow_target import run_follow_target
-    from robocfg.runners.grasp import run_grasp
-    from robocfg.runners.gripper import run_gripper
-    from robocfg.runners.pick_place import run_pick_place
-    from robocfg.runners.trajectory import run_trajectory
-
-    return {"gripper": run_gripper, "trajectory": run_trajectory, "follow_target": run_follow_target,
-            "pick_place": run_pick_place, "grasp": run_grasp}
-
-
-def run(task: CheckedTask, **options: Any) -> Any:
+def run(task: CheckedTask, options: RunOptions | None = None, **kwargs: Any) -> Any:
     """Run a task of any kind headless and return its typed report (the same object the CLI
-    prints as JSON: ``report.to_dict()`` or a dataclass). ``options`` are the kind's own
-    (``episodes=``, ``seed=`` for pick_place and grasp; ``with_obstacle=`` for follow_target).
-    A failed run raises ``RunFailed`` whose ``.report`` holds the report."""
-    result = _runners()[task.config.task](task, **options)
-    return result[0] if isinstance(result, tuple) else result  # (report, wall-clock timing)
+    writes as JSON). ``options`` is a :class:`robocfg.engine.RunOptions`; or give its fields as
+    keywords (``episodes=``, ``seed=``, ``arm=``...) and the kind's own options too
+    (``with_obstacle=`` for follow_target, ``no_sim=`` for trajectory). A failed run raises
+    ``RunFailed`` whose ``.report`` holds the report."""
+    import dataclasses
+
+    from robocfg.engine import RunOptions as Options
+    from robocfg.engine import runner_for
+
+    runner_type = runner_for(task.config.task)
+    own = {f.name for f in dataclasses.fields(Options)}
+    base = options or Options()
+    extras = None
+    kind_kw = {k: v for k, v in kwargs.items() if k not in own}
+    if runner_type.Options is not None:
+        extras = dataclasses.replace(base.extras or runner_type.Options(), **kind_kw)
+    elif kind_kw:
+        raise TypeError(f"run of a {task.config.task!r} task has no option(s) {sorted(kind_kw)}")
+    opts = dataclasses.replace(base, extras=extras, **{k: v for k, v in kwargs.items() if k in own})
+    runner = runner_type(task, opts)
+    runner.check()
+    return runner.run().report
 
 
 def make_world(task: CheckedTask, gui: bool = False) -> World:

@@ -78,6 +78,14 @@ class RunFailed(PhaseFailed):
         self.report = report
 
 
+class RunInterrupted(PhaseFailed):
+    """The run was asked to stop (SIGINT/SIGTERM) in the middle of ``phase``; the runner ends it
+    with its report marked ``interrupted``."""
+
+    def __init__(self, phase: str, signal_name: str = "a stop request"):
+        super().__init__(phase, f"interrupted by {signal_name}")
+
+
 class PhysicsDiverged(RunFailed):
     """NaN or exploding velocities in the simulation."""
 

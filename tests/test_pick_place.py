@@ -12,6 +12,7 @@ import yaml
 
 from robocfg.checks import load_task
 from robocfg.config import catalog
+from robocfg.engine.options import EpisodeObserver
 from robocfg.errors import ConfigError
 from robocfg.runners.pick_place import episode_setups, run_pick_place
 
@@ -96,7 +97,7 @@ def test_cli_quiet_json(tmp_path):
     assert "Traceback" not in proc.stderr
 
 
-class _ConstraintSpy:
+class _ConstraintSpy(EpisodeObserver):
     """Stands in for a Recorder: after every step, looks for any constraint touching the object."""
 
     def __init__(self, world):

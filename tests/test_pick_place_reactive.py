@@ -8,6 +8,7 @@ import pytest
 from robocfg.checks import load_task
 from robocfg.config import catalog
 from robocfg.config.commands import PickPlaceParams
+from robocfg.engine.options import EpisodeObserver
 from robocfg.runners.pick_place import run_pick_place
 
 
@@ -16,7 +17,7 @@ def task():
     return load_task(catalog.find("tasks", "pick_place_obstacle"))
 
 
-class _ContactSpy:
+class _ContactSpy(EpisodeObserver):
     """Stands in for a Recorder: after every physics step, counts steps where a moving robot link
     or the cube penetrates the wall."""
 

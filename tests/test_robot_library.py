@@ -10,10 +10,11 @@ import pytest
 
 from robocfg.checks import load_robot, load_task
 from robocfg.config import catalog
+from robocfg.engine.options import EpisodeObserver
 from robocfg.runners.pick_place import run_pick_place
 
 
-class _ArmWatch:
+class _ArmWatch(EpisodeObserver):
     """Stands in for a Recorder (``record=``) to read the world at the end of the episode."""
 
     def __init__(self, world):

@@ -80,7 +80,8 @@ def test_cli_failure_exit_1_with_phase_and_report(tmp_path):
     make_task(tmp_path, ROOT / "robots" / "panda.yaml", objects=[heavy], extra=extra, name="slip.yaml")
     out = _cli(str(tmp_path / "slip.yaml"), "--json", str(tmp_path / "r.json"), "-q", cwd=tmp_path)
     assert out.returncode == 1
-    assert "failed: hold:" in out.stderr and "Traceback" not in out.stderr
+    both = out.stdout + out.stderr  # the -q result line names the phase, printed once
+    assert both.count("failed: hold:") == 1 and "Traceback" not in out.stderr
     report = json.loads((tmp_path / "r.json").read_text())
     assert report["failed_phase"] == "hold" and not report["success"]
 

@@ -17,17 +17,19 @@ from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
 from robocfg.config.overrides import apply_overrides, blame_overrides
 from robocfg.config.robot import ParallelGripperConfig
-from robocfg.config.task import PickPlaceTask, TaskConfig
+from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
 from robocfg.errors import ConfigError, NotFound, Problem
 
-_TASK_ADAPTER: TypeAdapter | None = None
+_TASK_ADAPTER: tuple[tuple[str, ...], TypeAdapter] | None = None
 
 
 def task_adapter() -> TypeAdapter:
+    """The validator of task YAMLs, rebuilt when a task kind has been declared since."""
     global _TASK_ADAPTER
-    if _TASK_ADAPTER is None:
-        _TASK_ADAPTER = TypeAdapter(TaskConfig)
-    return _TASK_ADAPTER
+    kinds = tuple(TASK_MODELS)
+    if _TASK_ADAPTER is None or _TASK_ADAPTER[0] != kinds:
+        _TASK_ADAPTER = (kinds, TypeAdapter(task_union()))
+    return _TASK_ADAPTER[1]
 
 
 @dataclass

@@ -1,18 +1,11 @@
-"""Options every ``run`` command that records datasets shares, and the sink they build."""
+"""The dataset sink a ``run`` command records into (its ``--dataset*`` options are the kind's)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Literal
 
 import typer
-
-DatasetOpt = Annotated[Path | None, typer.Option(
-    "--dataset", file_okay=False, help="Record the episodes into this new directory (see --dataset-format).")]
-DatasetFormatOpt = Annotated[str, typer.Option(
-    "--dataset-format", help="lerobot (LeRobot v3.0: parquet + MP4) or hdf5 (robomimic layout).")]
-DatasetFpsOpt = Annotated[int, typer.Option("--dataset-fps", min=1, help="Frames per second of simulated time (must divide the physics rate).")]
-KeepOpt = Annotated[str, typer.Option("--keep", help="success: write successful episodes only; all: failures too, labelled.")]
 
 
 def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: int, arm: str | None,

@@ -5,21 +5,16 @@ phase and reason, with its count)."""
 from __future__ import annotations
 
 import signal
-from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Protocol
 
 import typer
 
+from robocfg.engine.options import EpisodeOutcome
+from robocfg.engine.runner import failure_lines
 
-class EpisodeOutcome(Protocol):
-    """The fields of an episode record that the shared printing reads."""
-
-    success: bool
-    failed_phase: str | None
-    reason: str
+__all__ = ["StopRequest", "check_record_episode", "failure_lines", "interrupted_line", "progress_bar", "stop_on_signals"]
 
 
 @dataclass
@@ -85,12 +80,6 @@ def progress_bar(label: str, episodes: int, verb: str, show: bool) -> Iterator[C
             bar.update(tid, advance=1, ok=f"{done[0]} {verb}")
 
         yield tick
-
-
-def failure_lines(episodes: Sequence[EpisodeOutcome]) -> list[str]:
-    """One line per distinct (phase, reason) among the failed episodes, most frequent first."""
-    counts = Counter((e.failed_phase or "?", e.reason) for e in episodes if not e.success)
-    return [f"{n} × {phase}: {reason}" for (phase, reason), n in counts.most_common()]
 
 
 def interrupted_line(stop: StopRequest, done: int, episodes: int, json_path: object) -> str:

@@ -1,23 +1,39 @@
-"""``robocfg run COMMAND``: one sub-command per runner (each in its own cli module)."""
+"""``robocfg run KIND``: one sub-command per registered task kind, made by one factory
+(``robocfg.cli.run_command``). The kinds load when ``run`` itself is used, so ``robocfg --help``
+and ``robocfg validate`` stay fast."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import typer
+from typer.core import TyperGroup
 
-run_app = typer.Typer(help="Run a task in PyBullet (headless by default).", no_args_is_help=True)
 
-from robocfg.cli import run_gripper  # noqa: E402
+class _KindsGroup(TyperGroup):
+    """The ``run`` group: its commands come from the task registry on first use."""
 
-run_app.command("gripper")(run_gripper.gripper)
-from robocfg.cli import run_trajectory  # noqa: E402
+    _kinds_loaded = False
 
-run_app.command("trajectory")(run_trajectory.run_trajectory)
-from robocfg.cli import run_pick_place  # noqa: E402
+    def _commands(self) -> Any:
+        if not self._kinds_loaded:
+            from robocfg.cli import run_pick_place  # noqa: F401  (registers the dataset hook)
+            from robocfg.cli.run_command import make_command
+            from robocfg.engine.registry import command_name, registered
 
-run_app.command("pick-place")(run_pick_place.run_pick_place)
-from robocfg.cli import run_follow_target  # noqa: E402
+            for kind, runner in registered().items():
+                sub = typer.Typer(add_completion=False, rich_markup_mode=None)
+                fn = make_command(runner)
+                sub.command(command_name(kind), help=fn.__doc__)(fn)
+                self.commands[command_name(kind)] = typer.main.get_command(sub)
+            self._kinds_loaded = True
+        return self.commands
 
-run_app.command("follow-target")(run_follow_target.run_follow_target)
-from robocfg.cli import run_grasp  # noqa: E402
+    def list_commands(self, ctx: Any) -> list[str]:
+        return list(self._commands())
 
-run_app.command("grasp")(run_grasp.run_grasp)
+    def get_command(self, ctx: Any, cmd_name: str) -> Any:
+        return self._commands().get(cmd_name)
+
+
+run_app = typer.Typer(cls=_KindsGroup, help="Run a task in PyBullet (headless by default).", no_args_is_help=True)

@@ -11,7 +11,8 @@ import typer
 
 
 def schema(
-    kind: Annotated[str, typer.Argument(help="robot, task, or a run report: report-pick-place, report-grasp")],
+    kind: Annotated[str, typer.Argument(help="robot, task, or a run report: report-<kind> (report-pick-place, "
+                                             "report-grasp, report-gripper, report-trajectory, report-follow-target)")],
     output: Annotated[Path | None, typer.Option("-o", "--output", help="Write to this file instead of stdout.")] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output file.")] = False,
     markdown: Annotated[bool, typer.Option("--markdown", help="Field reference tables (Markdown) instead of JSON Schema; "
@@ -20,9 +21,10 @@ def schema(
     """Print the JSON Schema of robot or task YAMLs (for yaml-language-server), or of a run's --json report."""
     from robocfg.errors import NotFound
 
-    if kind not in ("robot", "task", *REPORTS):
-        raise NotFound("schema kind", kind, ["robot", "task", *REPORTS])
-    if kind in REPORTS:
+    reports = report_kinds()
+    if kind not in ("robot", "task", *reports):
+        raise NotFound("schema kind", kind, ["robot", "task", *reports])
+    if kind in reports:
         text = json.dumps(report_schema(kind), indent=2) + "\n"
     elif markdown:
         text = markdown_text(kind)  # type: ignore[arg-type]
@@ -46,20 +48,22 @@ def schema(
     output.write_text(text)
 
 
-REPORTS = ("report-pick-place", "report-grasp")
+def report_kinds() -> list[str]:
+    """``report-<command>`` of every registered task kind."""
+    from robocfg.engine.registry import command_name, registered
+
+    return [f"report-{command_name(k)}" for k in registered()]
 
 
 def report_schema(kind: str) -> dict:
     """JSON Schema of a ``run`` command's ``--json`` report, from its typed report dataclass."""
     from pydantic import TypeAdapter
 
+    from robocfg.engine.registry import command_name, registered
     from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
-    if kind == "report-pick-place":
-        from robocfg.runners.pick_place_report import PickPlaceReport as Report
-    else:
-        from robocfg.runners.grasp_report import GraspReport as Report  # type: ignore[assignment]
-    out = TypeAdapter(Report).json_schema(mode="serialization")
+    report = next(r.report for k, r in registered().items() if f"report-{command_name(k)}" == kind)
+    out = TypeAdapter(report).json_schema(mode="serialization")
     out["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     out["title"] = f"robocfg run {kind.removeprefix('report-')} --json report (schema_version {REPORT_SCHEMA_VERSION})"
     return out

@@ -30,11 +30,18 @@ class Limits(Frozen):
     jerk: PositiveFloat | None = Field(None, description="Optional jerk limit (rad/s³).")
 
 
+Waypoint = str | list[FiniteFloat] | dict[str, FiniteFloat] | Pose
+
+
+def _home_only() -> list[Waypoint]:
+    return ["home"]
+
+
 class TrajectoryParams(Frozen):
     """``run trajectory``: time-optimal motion through joint-space or Cartesian waypoints."""
 
-    waypoints: list[str | list[FiniteFloat] | dict[str, FiniteFloat] | Pose] = Field(
-        default_factory=lambda: ["home"],
+    waypoints: list[Waypoint] = Field(
+        default_factory=_home_only,
         description="'home', a list in arm-joint order (rad), a {joint: rad} map, or a Cartesian TCP pose.",
     )
     stop_at_waypoints: bool = False

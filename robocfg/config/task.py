@@ -32,7 +32,9 @@ class RobotMount(Pose):
         return self
 
 
-class _TaskBase(Frozen):
+class TaskBase(Frozen):
+    """Fields every task YAML has, whatever its kind."""
+
     schema_version: SchemaVersion = Field(description="File format version; this is 1.")
     description: str = Field("", description="Free text.")
     robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
@@ -41,27 +43,27 @@ class _TaskBase(Frozen):
     cameras: list[TaskCamera] = Field(default_factory=list, description="Cameras recorded into datasets (--dataset); none: state only.")
 
 
-class GripperTask(_TaskBase):
+class GripperTask(TaskBase):
     task: Literal["gripper"] = Field(description="The command this file configures; selects the parameter block.")
     gripper: GripperParams = Field(default_factory=GripperParams, description="Parameters of `robocfg run gripper`.")
 
 
-class TrajectoryTask(_TaskBase):
+class TrajectoryTask(TaskBase):
     task: Literal["trajectory"] = Field(description="The command this file configures; selects the parameter block.")
     trajectory: TrajectoryParams = Field(default_factory=TrajectoryParams, description="Parameters of `robocfg run trajectory`.")
 
 
-class FollowTargetTask(_TaskBase):
+class FollowTargetTask(TaskBase):
     task: Literal["follow_target"] = Field(description="The command this file configures; selects the parameter block.")
     follow_target: FollowTargetParams = Field(default_factory=FollowTargetParams, description="Parameters of `robocfg run follow-target`.")
 
 
-class PickPlaceTask(_TaskBase):
+class PickPlaceTask(TaskBase):
     task: Literal["pick_place"] = Field(description="The command this file configures; selects the parameter block.")
     pick_place: PickPlaceParams = Field(description="Parameters of `robocfg run pick-place`.")
 
 
-class GraspTask(_TaskBase):
+class GraspTask(TaskBase):
     task: Literal["grasp"] = Field(description="The command this file configures; selects the parameter block.")
     grasp: GraspParams = Field(default_factory=GraspParams, description="Parameters of `robocfg run grasp`.")
 
@@ -70,4 +72,61 @@ TaskConfig = Annotated[
     GripperTask | TrajectoryTask | FollowTargetTask | PickPlaceTask | GraspTask,
     Field(discriminator="task"),
 ]
-TASK_KINDS = ("gripper", "trajectory", "follow_target", "pick_place", "grasp")
+"""The built-in task kinds as a static type (what type checkers see); the validator itself is
+built from ``TASK_MODELS`` by :func:`task_union`, so a kind registered later validates too."""
+
+TASK_MODELS: dict[str, type[TaskBase]] = {
+    "gripper": GripperTask, "trajectory": TrajectoryTask, "follow_target": FollowTargetTask,
+    "pick_place": PickPlaceTask, "grasp": GraspTask,
+}
+"""Task kind (the YAML's ``task:`` value) → its task model. The runner registry
+(``robocfg.engine.registry``) pairs each kind with its runner; a test checks the two agree.
+Every model holds the kind's parameters under a key named like the kind."""
+
+TASK_KINDS = tuple(TASK_MODELS)
+_BUILTIN_KINDS = frozenset(TASK_MODELS)
+
+
+def params_model(kind: str) -> type[Frozen]:
+    """The parameter model of ``kind`` (the type of the task model's ``<kind>`` field)."""
+    annotation = TASK_MODELS[kind].model_fields[kind].annotation
+    assert isinstance(annotation, type)  # every task model declares its block as one model class
+    return annotation
+
+
+def add_task_kind(kind: str, params: type[Frozen], description: str = "") -> type[TaskBase]:
+    """Declare a new task kind: a task model with ``task: <kind>`` and a ``<kind>:`` block of
+    ``params`` (defaults used when the block is left out) is added to ``TASK_MODELS``.
+    Declaring the same kind again with the same ``params`` returns the existing model; with other
+    ``params`` it is an error (two kinds cannot share a name)."""
+    from pydantic import create_model
+
+    if kind in TASK_MODELS:
+        if params_model(kind) is not params:
+            raise ValueError(f"task kind {kind!r} is already declared with {params_model(kind).__name__}")
+        return TASK_MODELS[kind]
+    if not kind.isidentifier():
+        raise ValueError(f"task kind {kind!r} must be a Python identifier (it is also the YAML key of its block)")
+    name = "".join(w.capitalize() for w in kind.split("_")) + "Task"
+    fields: dict = {
+        "task": (Literal[kind], Field(description="The command this file configures; selects the parameter block.")),
+        kind: (params, Field(default_factory=params, description=description or f"Parameters of `robocfg run {kind}`.")),
+    }
+    model = create_model(name, __base__=TaskBase, **fields)
+    TASK_MODELS[kind] = model
+    return model
+
+
+def remove_task_kind(kind: str) -> None:
+    """Forget a kind declared with :func:`add_task_kind` (the built-in five stay)."""
+    if kind in _BUILTIN_KINDS:
+        raise ValueError(f"task kind {kind!r} is built in")
+    TASK_MODELS.pop(kind, None)
+
+
+def task_union() -> object:
+    """The discriminated union of every declared task kind (what a task YAML validates against)."""
+    from functools import reduce
+    from operator import or_
+
+    return Annotated[reduce(or_, TASK_MODELS.values()), Field(discriminator="task")]

@@ -1,108 +1,314 @@
 """``run follow-target``: the TCP follows a moving target while a QP keeps the arm clear of obstacles.
 
-Loop, every control period (``control_rate``): target pose at ``t`` → joint state from PyBullet →
-:class:`~robocfg.motion.reactive.ReactiveController` step → position + velocity targets for the
-arm drives → physics steps. Measured after each period: TCP position/orientation error against
-the target at the same instant, robot–obstacle clearance (PyBullet ``getClosestPoints``),
-robot–obstacle contacts (``getContactPoints`` with penetration), and the controller's wall time.
+Loop, every control period (``control_rate``): target pose at ``t`` → joint state from the
+simulator → :class:`~robocfg.motion.reactive.ReactiveController` step → position + velocity
+targets for the arm drives → physics steps. Measured after each period: TCP position/orientation
+error against the target at the same instant, robot–obstacle clearance (closest points),
+robot–obstacle contacts (with penetration), and the controller's wall time.
 
-Statistics skip the first ``settle_time`` seconds. A target not reached (see :func:`_reached`) is
-reported with its residual; the run fails (``RunFailed``, exit 1) only with ``require_reach``.
+Statistics skip the first ``settle_time`` seconds. A target not reached is reported with its
+residual; the run fails (``RunFailed``, exit 1) only with ``require_reach``.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import FollowObstacle, FollowTargetParams
 from robocfg.config.scene import Body
-from robocfg.errors import RunFailed
-from robocfg.geometry import euler_deg_to_quat_xyzw, rotation_angle
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.engine.options import RunOptions, option
+from robocfg.engine.registry import register_task
+from robocfg.engine.runner import RunOutput, TaskRunner
+from robocfg.errors import RunFailed, RunInterrupted
+from robocfg.geometry import euler_deg_to_quat_xyzw, quat_to_matrix, rotation_angle
+from robocfg.runners.follow_target_report import (
+    FINAL_WINDOW,
+    FollowTargetResult,
+    Stats,
+    plot_series,
+    summarise,
+)
+
+if TYPE_CHECKING:
+    from robocfg.motion.targets import TargetMotion
+    from robocfg.sim.world import World
+
+__all__ = ["FollowTargetResult", "FollowTargetRunner", "Stats", "run_follow_target"]
 
 CLEARANCE_QUERY = 0.5  # m: clearances beyond this are reported as this value
-SAMPLE_RATE = 60.0  # Hz of the samples kept in the result
-FINAL_WINDOW = 0.25  # s averaged for the final (residual) error
 DEFAULT_OBSTACLE_SIZE = 0.05  # m: radius of the sphere added when with_obstacle has no obstacles listed
 GUI_SLIDER_RANGE = 0.4  # m either side of the initial target
+ENVIRONMENT = ("ground", "table", "pedestal")  # scene bodies counted as environment contacts
 
 
-@dataclass
-class Stats:
-    """mean / RMS / max of a series (units in the field name of the owner)."""
+@dataclass(frozen=True)
+class FollowTargetOptions:
+    """``run follow-target``'s own options."""
 
-    mean: float
-    rms: float
-    max: float
-
-    @classmethod
-    def of(cls, values: np.ndarray) -> Stats | None:
-        if len(values) == 0:
-            return None
-        v = np.asarray(values, float)
-        return cls(float(v.mean()), float(np.sqrt((v * v).mean())), float(v.max()))
+    with_obstacle: bool | None = field(default=None, metadata=option(
+        "--with-obstacle/--without-obstacle",
+        help="Add the task's follow_target.obstacles (default: the task's with_obstacle)."))
+    plot: Path | None = field(default=None, metadata=option(
+        "--plot", output=(".png",), help="Save a plot (.png) of tracking error and clearance against time."))
 
 
-@dataclass
-class FollowTargetResult:
-    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
-    task: str
-    robot: str
-    arm: str
-    motion: str
-    orientation: str
-    with_obstacle: bool
-    obstacles: list[str]
-    duration: float  # s
-    control_rate: float  # Hz (actual: physics rate / substeps)
-    safety_margin: float  # m
-    settle_time: float  # s
-    success: bool = False
-    position_error_mm: Stats | None = None  # after settling
-    orientation_error_deg: Stats | None = None
-    final_position_error_mm: float = math.nan  # residual, mean of the last FINAL_WINDOW
-    final_orientation_error_deg: float = math.nan
-    reached: bool = False
-    unreachable_reason: str | None = None
-    min_clearance_mm: float | None = None  # robot–obstacle, PyBullet closest points (None: no obstacle)
-    min_clearance_link: str | None = None
-    min_clearance_obstacle: str | None = None
-    contacts: int = 0  # robot–obstacle contact events (steps entering contact)
-    contact_steps: int = 0  # control steps with robot–obstacle penetration
-    environment_contact_steps: int = 0  # control steps with robot–ground/table/pedestal penetration
-    step_time_median_ms: float = math.nan  # controller wall time per control step
-    step_time_p95_ms: float = math.nan
-    step_cpu_median_ms: float = math.nan  # CPU time per control step (unaffected by other processes)
-    step_cpu_p95_ms: float = math.nan
-    steps: int = 0
-    soft_steps: int = 0  # steps solved with relaxed collision constraints
-    fallback_steps: int = 0  # steps where the QP failed: zero velocity commanded
-    escapes: int = 0  # local-minimum escapes started
-    blocked_time: float = 0.0  # s spent at the safety margin (model distance) while off target
-    collision_pairs: int = 0
-    samples: list[tuple[float, float, float, float | None]] = field(default_factory=list)  # (t s, pos mm, rot deg, clearance mm)
-    warnings: list[str] = field(default_factory=list)
-    failed_phase: str | None = None
-    reason: str | None = None
-    sim_time: float = 0.0
-    wall_time: float = 0.0
-    record: str | None = None
-    plot: str | None = None
+@register_task
+class FollowTargetRunner(TaskRunner):
+    kind = "follow_target"
+    params = FollowTargetParams
+    report = FollowTargetResult
+    Options = FollowTargetOptions
+    summary = ("Track a static / waypoint / circle / figure-8 target with a QP per control step (placo), keeping "
+               "the safety margin from obstacles, table and ground. With --gui, drag the target with the sliders.")
 
-    def to_dict(self) -> dict:
-        return asdict(self)
+    def run(self) -> RunOutput:
+        o, x = self.options, self.options.extras
+        assert isinstance(x, FollowTargetOptions)
+        return RunOutput(run_follow_target(self.task, gui=o.gui, with_obstacle=x.with_obstacle, record=o.record,
+                                           plot=x.plot, arm=o.arm, should_stop=o.should_stop))
 
 
-def _euler_matrix(rpy_deg) -> np.ndarray:
-    from robocfg.geometry import quat_to_matrix
+def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool | None = None,
+                      record: Path | None = None, plot: Path | None = None,
+                      params: FollowTargetParams | None = None, realtime: bool | None = None,
+                      arm: str | None = None, should_stop=None) -> FollowTargetResult:
+    """Run the follow-target task; returns the result, or raises RunFailed carrying it.
 
-    return quat_to_matrix(euler_deg_to_quat_xyzw(rpy_deg))
+    ``with_obstacle`` overrides the task's switch; ``params`` overrides the task's
+    ``follow_target`` block (benchmarks use it); ``realtime`` paces the loop to the wall clock
+    (default: with ``gui``); ``should_stop`` (SIGINT) ends the loop early, the result marked
+    ``interrupted``.
+    """
+    from robocfg.motion.targets import TargetMotion
+    from robocfg.sim.world import World
+
+    params = params or task.config.follow_target  # type: ignore[union-attr]
+    assert params is not None
+    t_wall = time.perf_counter()
+    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
+                          params.orientation, math.radians(params.follow_angle_deg))
+    with World(task, gui=gui) as world:
+        run = _FollowRun(task, world, params, target, RunOptions(gui=gui, record=record, arm=arm, should_stop=should_stop),
+                         params.with_obstacle if with_obstacle is None else with_obstacle)
+        run.loop(gui if realtime is None else realtime)
+        result = run.finish(plot, t_wall)
+    if not result.reached:
+        tol = f"{params.reach_tolerance * 1000:.1f} mm / {math.degrees(params.orientation_tolerance):.2f} deg"
+        e = result.position_error_mm
+        at_rest = target.end_time <= params.duration - FINAL_WINDOW
+        moving = "" if e is None or at_rest else f"RMS {e.rms:.1f} mm after settling, "
+        msg = (f"target not reached within {tol}: {moving}residual {result.final_position_error_mm:.1f} mm / "
+               f"{result.final_orientation_error_deg:.2f} deg ({result.unreachable_reason})")
+        result.warnings.append(msg)
+        if params.require_reach and not result.interrupted:
+            result.failed_phase, result.reason = "track", msg
+            raise RunFailed("track", msg, report=result)
+    result.success = result.reached or not params.require_reach
+    return result
+
+
+class _FollowRun:
+    """One follow-target run in a built world: obstacles spawned, controller built, then ``loop``."""
+
+    def __init__(self, task: CheckedTask, world: World, params: FollowTargetParams, target: TargetMotion,
+                 options: RunOptions, use_obstacle: bool):
+        self.task, self.world, self.params, self.target = task, world, params, target
+        world.should_stop = options.should_stop
+        self.arm = world.robot.arm(options.arm)
+        self.n_sub = max(1, round(1.0 / (params.control_rate * world.dt)))
+        self.ctrl_dt = self.n_sub * world.dt
+        obstacles = _obstacles(params, use_obstacle, self.arm.tcp_pose()[:3, 3], target.position(0.0))
+        self.result = r = FollowTargetResult(
+            task=str(task.path), robot=task.robots[0].config.name, arm=self.arm.config.name, motion=params.motion.type,
+            orientation=params.orientation, with_obstacle=use_obstacle,
+            obstacles=[o.name for o in task.config.scene.obstacles] + [o.name for o in obstacles],
+            duration=params.duration, control_rate=1.0 / self.ctrl_dt, safety_margin=params.safety_margin,
+            settle_time=params.settle_time)
+        r.warnings = [p.format() for p in task.warnings] + list(world.warnings)
+        if abs(1.0 / self.ctrl_dt - params.control_rate) > 0.01 * params.control_rate:
+            r.warnings.append(f"control_rate {params.control_rate:g} Hz is not a divisor of the physics rate "
+                              f"{1.0 / world.dt:g} Hz: running at {1.0 / self.ctrl_dt:g} Hz ({self.n_sub} physics steps)")
+        self.moving = self._spawn(obstacles)
+        self.ctrl = self._controller(obstacles)
+        self.obstacle_ids = {n: world.bodies[n] for n in r.obstacles if n in world.bodies}
+        self.env_ids = {n: world.bodies[n] for n in ENVIRONMENT if n in world.bodies}
+        self.in_contact = False
+        self._start_warnings()
+        self.marker = world.add_marker([float(v) for v in target.position(0.0)])
+        world.bodies["_target"] = self.marker
+        self.sliders = _Sliders(world, target.position(0.0)) if options.gui else None
+        self.recorder = None
+        if options.record is not None:
+            from robocfg.sim.record import CameraView, Recorder
+
+            c = target.center
+            view = CameraView(target=(float(c[0]) * 0.6, float(c[1]), float(c[2]) * 0.8), distance=1.5,
+                              yaw_deg=60.0, pitch_deg=-25.0)
+            self.recorder = Recorder(world, options.record, fps=15.0, camera=view)
+        self.series: list[tuple[float, float, float, float]] = []
+        self.times: list[float] = []
+        self.cpu: list[float] = []
+
+    def _spawn(self, obstacles: list[FollowObstacle]) -> dict[str, tuple[TargetMotion, np.ndarray]]:
+        """Spawn the obstacles (static bodies); the moving ones with their motion and pose."""
+        from robocfg.geometry import pose_matrix
+        from robocfg.motion.targets import TargetMotion
+
+        moving: dict[str, tuple[TargetMotion, np.ndarray]] = {}
+        for ob in obstacles:
+            body = Body(name=ob.name, shape=ob.shape, size=list(ob.size), mass=0.0, color=list(ob.color),
+                        position=list(ob.position), quat_xyzw=list(ob.quaternion_xyzw()))
+            self.world.add_body(body, static=True)
+            if ob.motion is not None:
+                moving[ob.name] = (TargetMotion(ob.motion), pose_matrix(ob))
+                self.world.set_body_pose(ob.name, moving[ob.name][0].position(0.0), ob.quaternion_xyzw())
+        return moving
+
+    def _controller(self, obstacles: list[FollowObstacle]) -> Any:
+        from robocfg.motion.reactive import EscapeSettings, ReactiveController, ReactiveSettings
+        from robocfg.motion.reactive.setup import arm_spec, body_shape, scene_shapes
+        from robocfg.sim.loading import prepared_urdf
+
+        p, checked = self.params, self.task.robots[0]
+        env, skipped = scene_shapes(self.task.config.scene)
+        for name in skipped:
+            self.result.warnings.append(f"obstacle {name!r} is a mesh: the controller does not avoid it (only measured)")
+        for ob in obstacles:
+            shape = body_shape(ob)
+            if shape is None:  # obstacles are primitives; only scene meshes have no shape
+                continue
+            if ob.name in self.moving:
+                shape.pose[:3, 3] = self.moving[ob.name][0].position(0.0)
+            env.append(shape)
+        spec = arm_spec(checked, prepared_urdf(checked), self.world.robot.base_pose(), self.arm.config.name,
+                        p.acceleration, p.velocity_scale)
+        settings = ReactiveSettings(dt=self.ctrl_dt, margin=p.safety_margin, gain=p.gain,
+                                    max_linear_speed=p.max_speed, posture_weight=p.posture_weight,
+                                    self_collision=p.self_collision, escape=EscapeSettings(enabled=p.escape))
+        ctrl = ReactiveController(spec, env, settings)
+        ctrl.reset(self.arm.joint_positions())
+        self.result.collision_pairs = len(ctrl.pairs)
+        return ctrl
+
+    # ---- the control loop ------------------------------------------------------------------
+    def loop(self, realtime: bool) -> None:
+        """Control steps until ``duration``, the GUI closed, a failure (kept in the result) or a stop."""
+        from robocfg.sim.queries import GUI_ERROR
+
+        w, r = self.world, self.result
+        dragged = None
+        try:
+            for _ in range(max(1, round(self.params.duration / self.ctrl_dt))):
+                t = w.t
+                self._move_obstacles(t + self.ctrl_dt)
+                try:
+                    dragged = self.sliders.read(dragged) if self.sliders is not None else None
+                    q_now = self.arm.joint_positions()
+                except GUI_ERROR:  # the GUI window was closed
+                    r.warnings.append(f"GUI closed at t = {w.t:.2f} s: run stopped")
+                    break
+                T_goal, v_goal = _goal(self.target, t + self.ctrl_dt, dragged)
+                res = self.ctrl.step(T_goal, q_measured=q_now, velocity=v_goal)
+                self.times.append(res.solve_time)
+                self.cpu.append(res.cpu_time)
+                if res.blocked:
+                    r.blocked_time += self.ctrl_dt
+                self.arm.command(res.q, res.dq)
+                t_step = time.perf_counter()
+                w.step(self.n_sub)
+                self._measure(dragged)
+                if realtime:
+                    time.sleep(max(0.0, self.ctrl_dt - (time.perf_counter() - t_step)))
+        except RunInterrupted:
+            r.interrupted = True
+        except RunFailed as exc:
+            r.failed_phase, r.reason = exc.phase, exc.reason
+            self.failure = exc
+
+    failure: RunFailed | None = None
+
+    def _move_obstacles(self, t: float) -> None:
+        for name, (m, T_ob) in self.moving.items():
+            T_ob[:3, 3] = m.position(t)
+            self.world.set_body_pose(name, T_ob[:3, 3], self.world.body_pose(name)[1])
+            self.ctrl.set_obstacle_pose(name, T_ob, m.velocity(t)[:3])
+
+    def _measure(self, dragged: np.ndarray | None) -> None:
+        """Errors against the target now, clearance and contacts after one control period."""
+        w, r = self.world, self.result
+        T_goal, _ = _goal(self.target, w.t, dragged)
+        w.set_body_pose(self.marker, T_goal[:3, 3])
+        tcp = self.arm.tcp_pose()
+        e_pos = float(np.linalg.norm(tcp[:3, 3] - T_goal[:3, 3]))
+        e_rot = rotation_angle(tcp[:3, :3], T_goal[:3, :3])
+        clearance = math.inf
+        if self.obstacle_ids:
+            clearance, link, obst = self._clearance()
+            if r.min_clearance_mm is None or clearance * 1000 < r.min_clearance_mm:
+                r.min_clearance_mm = clearance * 1000
+                r.min_clearance_link, r.min_clearance_obstacle = link, obst
+            touching = self._touching(self.obstacle_ids)
+            r.contact_steps += touching
+            r.contacts += touching and not self.in_contact
+            self.in_contact = touching
+        if self.env_ids and self._touching(self.env_ids):
+            r.environment_contact_steps += 1
+        self.series.append((w.t, e_pos, e_rot, clearance))
+        if self.recorder is not None:
+            self.recorder.maybe_capture()
+
+    def _clearance(self) -> tuple[float, str | None, str | None]:
+        """(distance m, robot link, obstacle) of the closest robot–obstacle pair (CLEARANCE_QUERY if none is closer)."""
+        robot = self.world.robot
+        best: tuple[float, str | None, str | None] = (CLEARANCE_QUERY, None, None)
+        for name, bid in self.obstacle_ids.items():
+            for c in self.world.closest_points(robot.body_id, bid, CLEARANCE_QUERY):
+                if c.distance < best[0]:
+                    best = (c.distance, robot.link_name(c.link_a), name)
+        return best
+
+    def _touching(self, bodies: dict[str, int]) -> bool:
+        """Any penetrating contact between a moving robot link (not the base) and ``bodies``."""
+        robot = self.world.robot.body_id
+        return any(c.distance < 0.0 and c.link_a != -1
+                   for bid in bodies.values() for c in self.world.contact_points(robot, bid))
+
+    def _start_warnings(self) -> None:
+        margin, robot = self.params.safety_margin, self.world.robot
+        for name, bid in self.obstacle_ids.items():
+            pts = self.world.closest_points(robot.body_id, bid, margin)
+            if not pts:
+                continue
+            c = min(pts, key=lambda c: c.distance)
+            link = robot.link_name(c.link_a)
+            if c.distance < 0:
+                self.result.warnings.append(f"obstacle {name!r} overlaps robot link {link!r} at the start by "
+                                            f"{-c.distance * 1000:.1f} mm: collision constraints are relaxed until "
+                                            "the robot is clear")
+            else:
+                self.result.warnings.append(f"obstacle {name!r} is {c.distance * 1000:.1f} mm from robot link {link!r} "
+                                            f"at the start, inside the safety margin ({margin * 1000:.0f} mm)")
+
+    def finish(self, plot: Path | None, t_wall: float) -> FollowTargetResult:
+        """Statistics, recording and plot; re-raises a failure with the result attached."""
+        r = self.result
+        summarise(r, self.series, self.times, self.cpu, self.params, self.ctrl)
+        r.sim_time = self.world.t
+        if self.recorder is not None:
+            r.record = str(self.recorder.save())
+        if plot is not None and self.series:
+            r.plot = str(plot_series(plot, self.series, r.safety_margin))
+        r.wall_time = time.perf_counter() - t_wall
+        if self.failure is not None:
+            raise RunFailed(self.failure.phase, self.failure.reason, report=r) from None
+        return r
 
 
 def _obstacles(params: FollowTargetParams, with_obstacle: bool, start: np.ndarray, goal: np.ndarray) -> list[FollowObstacle]:
@@ -114,185 +320,7 @@ def _obstacles(params: FollowTargetParams, with_obstacle: bool, start: np.ndarra
     return [FollowObstacle(name="obstacle", shape="sphere", size=[DEFAULT_OBSTACLE_SIZE], position=[float(v) for v in mid])]
 
 
-class _Probe:
-    """PyBullet measurements: closest robot–obstacle distance and contacts."""
-
-    def __init__(self, world, obstacles: dict[str, int], environment: dict[str, int]):
-        import pybullet as p
-
-        self.p, self.world = p, world
-        self.robot = world.robot
-        self.obstacles, self.environment = obstacles, environment
-        self.in_contact = False
-
-    def clearance(self) -> tuple[float, str | None, str | None]:
-        """(distance m, robot link, obstacle) of the closest robot–obstacle pair (CLEARANCE_QUERY if none is closer)."""
-        best = (CLEARANCE_QUERY, None, None)
-        for name, bid in self.obstacles.items():
-            for c in self.p.getClosestPoints(self.robot.body_id, bid, CLEARANCE_QUERY, physicsClientId=self.world.client):
-                if c[8] < best[0]:
-                    best = (float(c[8]), self.robot.link_name(c[3]), name)
-        return best
-
-    def contacts(self, bodies: dict[str, int]) -> bool:
-        """Any penetrating contact between a moving robot link (not the base) and ``bodies``."""
-        for bid in bodies.values():
-            for c in self.p.getContactPoints(self.robot.body_id, bid, physicsClientId=self.world.client):
-                if c[8] < 0.0 and c[3] != -1:
-                    return True
-        return False
-
-
-def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool | None = None,
-                      record: Path | None = None, plot: Path | None = None,
-                      params: FollowTargetParams | None = None, realtime: bool | None = None) -> FollowTargetResult:
-    """Run the follow-target task; returns the result, or raises RunFailed carrying it.
-
-    ``with_obstacle`` overrides the task's switch; ``params`` overrides the task's
-    ``follow_target`` block (benchmarks use it); ``realtime`` paces the loop to the wall clock
-    (default: with ``gui``).
-    """
-    import pybullet
-
-    from robocfg.geometry import pose_matrix
-    from robocfg.motion.reactive import EscapeSettings, ReactiveController, ReactiveSettings
-    from robocfg.motion.reactive.setup import arm_spec, body_shape, scene_shapes
-    from robocfg.motion.targets import TargetMotion
-    from robocfg.sim.loading import prepared_urdf
-    from robocfg.sim.record import CameraView, Recorder
-    from robocfg.sim.world import World
-
-    params = params or task.config.follow_target  # type: ignore[union-attr]
-    use_obstacle = params.with_obstacle if with_obstacle is None else with_obstacle
-    checked = task.robots[0]
-    realtime = gui if realtime is None else realtime
-    t_wall = time.perf_counter()
-    target = TargetMotion(params.motion, _euler_matrix(params.target_euler_deg), params.orientation,
-                          math.radians(params.follow_angle_deg))
-    with World(task, gui=gui) as world:
-        arm = world.robot.arm()
-        n_sub = max(1, round(1.0 / (params.control_rate * world.dt)))
-        ctrl_dt = n_sub * world.dt
-        start_tcp = arm.tcp_pose()[:3, 3]
-        obstacles = _obstacles(params, use_obstacle, start_tcp, target.position(0.0))
-        result = FollowTargetResult(
-            task=str(task.path), robot=checked.config.name, arm=arm.config.name, motion=params.motion.type,
-            orientation=params.orientation, with_obstacle=use_obstacle,
-            obstacles=[o.name for o in task.config.scene.obstacles] + [o.name for o in obstacles],
-            duration=params.duration, control_rate=1.0 / ctrl_dt, safety_margin=params.safety_margin,
-            settle_time=params.settle_time)
-        result.warnings = [p.format() for p in task.warnings] + list(world.warnings)
-        if abs(1.0 / ctrl_dt - params.control_rate) > 0.01 * params.control_rate:
-            result.warnings.append(f"control_rate {params.control_rate:g} Hz is not a divisor of the physics rate "
-                                   f"{1.0 / world.dt:g} Hz: running at {1.0 / ctrl_dt:g} Hz ({n_sub} physics steps)")
-        moving: dict[str, tuple[TargetMotion, np.ndarray]] = {}
-        for ob in obstacles:
-            body = Body(name=ob.name, shape=ob.shape, size=list(ob.size), mass=0.0, color=list(ob.color),
-                        position=list(ob.position), quat_xyzw=list(ob.quaternion_xyzw()))
-            world.add_body(body, static=True)
-            if ob.motion is not None:
-                T_ob = pose_matrix(ob)
-                moving[ob.name] = (TargetMotion(ob.motion), T_ob)
-                world.set_body_pose(ob.name, moving[ob.name][0].position(0.0), ob.quaternion_xyzw())
-        env, skipped = scene_shapes(task.config.scene)
-        for name in skipped:
-            result.warnings.append(f"obstacle {name!r} is a mesh: the controller does not avoid it (only measured)")
-        for ob in obstacles:
-            shape = body_shape(ob)
-            if ob.name in moving:
-                shape.pose[:3, 3] = moving[ob.name][0].position(0.0)
-            env.append(shape)
-        spec = arm_spec(checked, prepared_urdf(checked), world.robot.base_pose(), arm.config.name,
-                        params.acceleration, params.velocity_scale)
-        settings = ReactiveSettings(dt=ctrl_dt, margin=params.safety_margin, gain=params.gain,
-                                    max_linear_speed=params.max_speed, posture_weight=params.posture_weight,
-                                    self_collision=params.self_collision, escape=EscapeSettings(enabled=params.escape))
-        ctrl = ReactiveController(spec, env, settings)
-        ctrl.reset(arm.joint_positions())
-        result.collision_pairs = len(ctrl.pairs)
-        obstacle_ids = {n: world.bodies[n] for n in result.obstacles if n in world.bodies}
-        env_ids = {n: world.bodies[n] for n in ("ground", "table", "pedestal") if n in world.bodies}
-        probe = _Probe(world, obstacle_ids, env_ids)
-        _start_warnings(result, probe, params.safety_margin)
-        marker = _marker(world, target.position(0.0))
-        sliders = _sliders(world, target.position(0.0)) if gui else None
-        recorder = None
-        if record is not None:
-            c = target.center
-            view = CameraView(target=(float(c[0]) * 0.6, float(c[1]), float(c[2]) * 0.8), distance=1.5, yaw_deg=60.0, pitch_deg=-25.0)
-            recorder = Recorder(world, record, fps=15.0, camera=view)
-        series: list[tuple[float, float, float, float]] = []
-        times: list[float] = []
-        cpu: list[float] = []
-        dragged = None
-        try:
-            steps = max(1, round(params.duration / ctrl_dt))
-            for _ in range(steps):
-                t = world.t
-                for name, (m, T_ob) in moving.items():
-                    T_ob[:3, 3] = m.position(t + ctrl_dt)
-                    world.set_body_pose(name, T_ob[:3, 3], world.body_pose(name)[1])
-                    ctrl.set_obstacle_pose(name, T_ob, m.velocity(t + ctrl_dt)[:3])
-                try:
-                    dragged = _read_sliders(world, sliders, dragged)
-                    q_now = arm.joint_positions()
-                except pybullet.error:  # the GUI window was closed
-                    result.warnings.append(f"GUI closed at t = {world.t:.2f} s: run stopped")
-                    break
-                T_goal, v_goal = _goal(target, t + ctrl_dt, dragged)
-                res = ctrl.step(T_goal, q_measured=q_now, velocity=v_goal)
-                times.append(res.solve_time)
-                cpu.append(res.cpu_time)
-                if res.blocked:
-                    result.blocked_time += ctrl_dt
-                arm.command(res.q, res.dq)
-                t_step = time.perf_counter()
-                world.step(n_sub)
-                T_goal, _ = _goal(target, world.t, dragged)
-                world.set_body_pose(marker, T_goal[:3, 3])
-                tcp = arm.tcp_pose()
-                e_pos = float(np.linalg.norm(tcp[:3, 3] - T_goal[:3, 3]))
-                e_rot = rotation_angle(tcp[:3, :3], T_goal[:3, :3])
-                clearance = math.inf
-                if obstacle_ids:
-                    clearance, link, obst = probe.clearance()
-                    if result.min_clearance_mm is None or clearance * 1000 < result.min_clearance_mm:
-                        result.min_clearance_mm = clearance * 1000
-                        result.min_clearance_link, result.min_clearance_obstacle = link, obst
-                    touching = probe.contacts(obstacle_ids)
-                    result.contact_steps += touching
-                    result.contacts += touching and not probe.in_contact
-                    probe.in_contact = touching
-                if env_ids and probe.contacts(env_ids):
-                    result.environment_contact_steps += 1
-                series.append((world.t, e_pos, e_rot, clearance))
-                if recorder is not None:
-                    recorder.maybe_capture()
-                if realtime:
-                    time.sleep(max(0.0, ctrl_dt - (time.perf_counter() - t_step)))
-        except RunFailed as exc:
-            result.failed_phase, result.reason = exc.phase, exc.reason
-            _summarise(result, series, times, cpu, params, ctrl)
-            _finish(result, world, recorder, plot, series, t_wall)
-            raise RunFailed(exc.phase, exc.reason, report=result) from None
-        _summarise(result, series, times, cpu, params, ctrl)
-        _finish(result, world, recorder, plot, series, t_wall)
-    if not result.reached:
-        tol = f"{params.reach_tolerance * 1000:.1f} mm / {math.degrees(params.orientation_tolerance):.2f} deg"
-        e = result.position_error_mm
-        at_rest = target.end_time <= params.duration - FINAL_WINDOW
-        moving = "" if e is None or at_rest else f"RMS {e.rms:.1f} mm after settling, "
-        msg = (f"target not reached within {tol}: {moving}residual {result.final_position_error_mm:.1f} mm / "
-               f"{result.final_orientation_error_deg:.2f} deg ({result.unreachable_reason})")
-        result.warnings.append(msg)
-        if params.require_reach:
-            result.failed_phase, result.reason = "track", msg
-            raise RunFailed("track", msg, report=result)
-    result.success = result.reached or not params.require_reach
-    return result
-
-
-def _goal(target, t: float, dragged: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+def _goal(target: TargetMotion, t: float, dragged: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
     T = target.pose(t)
     if dragged is not None:
         T[:3, 3] = dragged
@@ -300,135 +328,16 @@ def _goal(target, t: float, dragged: np.ndarray | None) -> tuple[np.ndarray, np.
     return T, target.velocity(t)
 
 
-def _start_warnings(result: FollowTargetResult, probe: _Probe, margin: float) -> None:
-    if not probe.obstacles:
-        return
-    for name, bid in probe.obstacles.items():
-        pts = probe.p.getClosestPoints(probe.robot.body_id, bid, margin, physicsClientId=probe.world.client)
-        if not pts:
-            continue
-        c = min(pts, key=lambda c: c[8])
-        link = probe.robot.link_name(c[3])
-        if c[8] < 0:
-            result.warnings.append(f"obstacle {name!r} overlaps robot link {link!r} at the start by {-c[8] * 1000:.1f} mm: "
-                                   "collision constraints are relaxed until the robot is clear")
-        else:
-            result.warnings.append(f"obstacle {name!r} is {c[8] * 1000:.1f} mm from robot link {link!r} at the start, "
-                                   f"inside the safety margin ({margin * 1000:.0f} mm)")
+class _Sliders:
+    """GUI sliders for the target position: moving one switches to the slider target."""
 
+    def __init__(self, world: World, position: np.ndarray):
+        self.world = world
+        self.ids = [(world.add_slider(f"target {axis} (m)", float(v) - GUI_SLIDER_RANGE, float(v) + GUI_SLIDER_RANGE,
+                                      float(v)), float(v)) for axis, v in zip("xyz", position, strict=True)]
 
-def _summarise(result: FollowTargetResult, series, times, cpu, params: FollowTargetParams, ctrl) -> None:
-    result.steps = len(times)
-    result.soft_steps, result.fallback_steps, result.escapes = ctrl.soft_steps, ctrl.fallbacks, ctrl.escape.count
-    if times:
-        ms = np.asarray(times) * 1000
-        result.step_time_median_ms = float(np.median(ms))
-        result.step_time_p95_ms = float(np.percentile(ms, 95))
-        ms = np.asarray(cpu) * 1000
-        result.step_cpu_median_ms = float(np.median(ms))
-        result.step_cpu_p95_ms = float(np.percentile(ms, 95))
-    if not series:
-        return
-    a = np.asarray(series, float)
-    t, pos, rot = a[:, 0], a[:, 1], a[:, 2]
-    settled = t >= params.settle_time
-    result.position_error_mm = Stats.of(pos[settled] * 1000)
-    result.orientation_error_deg = Stats.of(np.degrees(rot[settled]))
-    final = t >= t[-1] - FINAL_WINDOW
-    result.final_position_error_mm = float(pos[final].mean() * 1000)
-    result.final_orientation_error_deg = float(np.degrees(rot[final].mean()))
-    every = max(1, round(1.0 / (SAMPLE_RATE * (t[1] - t[0])))) if len(t) > 1 else 1
-    result.samples = [(round(float(r[0]), 4), round(float(r[1]) * 1000, 3), round(math.degrees(r[2]), 4),
-                       None if math.isinf(r[3]) else round(float(r[3]) * 1000, 2)) for r in a[::every]]
-    result.reached, result.unreachable_reason = _reached(result, params, ctrl)
-
-
-def _reached(result: FollowTargetResult, params: FollowTargetParams, ctrl) -> tuple[bool, str | None]:
-    """Reached: a target at rest at the end (static, waypoints) is within tolerance over the last
-    FINAL_WINDOW; a moving one is tracked with RMS error within tolerance after settling."""
-    from robocfg.motion.targets import TargetMotion
-
-    at_rest = TargetMotion(params.motion).end_time <= params.duration - FINAL_WINDOW
-    if at_rest:
-        pos, rot = result.final_position_error_mm, result.final_orientation_error_deg
-    elif result.position_error_mm is not None and result.orientation_error_deg is not None:
-        pos, rot = result.position_error_mm.rms, result.orientation_error_deg.rms
-    else:
-        return False, "the run ended before the settle time"
-    if pos <= params.reach_tolerance * 1000 and rot <= math.degrees(params.orientation_tolerance):
-        return True, None
-    if result.blocked_time > 0:
-        return False, f"blocked by the environment for {result.blocked_time:.2f} s (held at the safety margin)"
-    if ctrl.fallbacks:
-        return False, f"the QP failed on {ctrl.fallbacks} step(s)"
-    return False, "outside the workspace (or at a joint limit) for this orientation"
-
-
-def _finish(result: FollowTargetResult, world, recorder, plot: Path | None, series, t_wall: float) -> None:
-    result.sim_time = world.t
-    if recorder is not None:
-        result.record = str(recorder.save())
-    if plot is not None and series:
-        result.plot = str(_plot(plot, series, result.safety_margin))
-    result.wall_time = time.perf_counter() - t_wall
-
-
-def _plot(path: Path, series, margin: float) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    a = np.asarray(series, float)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
-    axes[0].plot(a[:, 0], a[:, 1] * 1000, label="position error (mm)")
-    ax2 = axes[0].twinx()
-    ax2.plot(a[:, 0], np.degrees(a[:, 2]), color="tab:orange", label="orientation error (deg)")
-    axes[0].set_ylabel("position error (mm)")
-    ax2.set_ylabel("orientation error (deg)")
-    clear = np.where(np.isinf(a[:, 3]), np.nan, a[:, 3] * 1000)
-    axes[1].plot(a[:, 0], clear, label="robot–obstacle clearance")
-    axes[1].axhline(margin * 1000, color="tab:red", linestyle="--", label="safety margin")
-    axes[1].set_ylabel("clearance (mm)")
-    axes[1].set_xlabel("t (s)")
-    axes[1].legend(loc="upper right")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
-
-
-def _marker(world, position: np.ndarray) -> int | None:
-    """A green, collision-free sphere showing the target (for the GUI and recordings)."""
-    import pybullet as p
-
-    vis = p.createVisualShape(p.GEOM_SPHERE, radius=0.015, rgbaColor=[0.1, 0.8, 0.2, 0.8], physicsClientId=world.client)
-    bid = p.createMultiBody(0.0, -1, vis, [float(v) for v in position], physicsClientId=world.client)
-    world.bodies["_target"] = bid
-    return bid
-
-
-def _sliders(world, position: np.ndarray) -> list[tuple[int, float]]:
-    """Debug sliders for the target position (GUI): moving one switches to the slider target."""
-    import pybullet as p
-
-    p.configureDebugVisualizer(p.COV_ENABLE_GUI, 1, physicsClientId=world.client)
-    out = []
-    for axis, v in zip("xyz", position, strict=True):
-        sid = p.addUserDebugParameter(f"target {axis} (m)", float(v) - GUI_SLIDER_RANGE, float(v) + GUI_SLIDER_RANGE,
-                                      float(v), physicsClientId=world.client)
-        out.append((sid, float(v)))
-    return out
-
-
-def _read_sliders(world, sliders, dragged: np.ndarray | None) -> np.ndarray | None:
-    if not sliders:
-        return dragged
-    import pybullet as p
-
-    values = np.array([p.readUserDebugParameter(sid, physicsClientId=world.client) for sid, _ in sliders])
-    if dragged is None and np.all(np.abs(values - np.array([v for _, v in sliders])) < 1e-9):
-        return None
-    return values
+    def read(self, dragged: np.ndarray | None) -> np.ndarray | None:
+        values = np.array([self.world.read_slider(sid) for sid, _ in self.ids])
+        if dragged is None and np.all(np.abs(values - np.array([v for _, v in self.ids])) < 1e-9):
+            return None
+        return values

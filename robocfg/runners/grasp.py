@@ -1,340 +1,181 @@
-"""``run grasp``: perceive → plan antipodal grasps → execute the best → verify; robot-agnostic.
+"""``run grasp``: grasp planning from simulated depth cameras, then lift, shake and verify.
 
-Every episode: spawn ``objects[k % n]`` at a random spot and yaw, let it settle, render the
-cameras, fuse and process the cloud, plan ranked reachable grasps (``robocfg.grasp.antipodal``),
-then: pre-grasp (``pre_grasp_distance`` back along the approach, a joint-space move) → approach
-(straight line) → close until held → lift straight up → shake (±``shake_amplitude`` along y) →
-verify the object is still held and raised. A failed attempt opens the gripper, returns home,
-re-perceives and tries the best grasp not near one that already failed (``max_attempts`` in all).
-Grasp → EE target goes through ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``).
+Episode k spawns ``objects[k % n]`` at a spot and yaw drawn with ``default_rng([seed, k])``
+and runs :class:`robocfg.runners.grasp_episode._Episode` in the session's world, restored
+before each episode (the gripper's box model is measured once, before the snapshot).
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
-import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import GraspParams, Limits
 from robocfg.config.robot import ParallelGripperConfig
-from robocfg.config.scene import Body
-from robocfg.errors import PhaseFailed, RobocfgError
-from robocfg.geometry import rotation_angle
-from robocfg.grasp.antipodal import Candidate, PlannerSettings, PlanResult, plan_grasps
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
-from robocfg.motion.moves import ArmMover, MoveFailed, bound_ik_by_iterations
-from robocfg.runners.grasp_report import (
-    AttemptRecord,
-    GraspEpisode,
-    GraspReport,
-    GraspTiming,
-    summarise,
-)
+from robocfg.engine.options import FrameRecorder, RunOptions, option
+from robocfg.engine.registry import register_task
+from robocfg.engine.session import EpisodeSession, EpisodicRunner, episode_rng
+from robocfg.errors import ConfigError, Problem, RobocfgError
+from robocfg.motion.moves import bound_ik_by_iterations
+from robocfg.runners.grasp_episode import EpisodeFailed, EpisodeSetup, _Context, _Episode
+from robocfg.runners.grasp_report import GraspEpisode, GraspReport, GraspTiming, summarise
 
-Log = Callable[[str], None]
-SPAWN_SETTLE = 0.6  # s the object is left to come to rest before perception
-REACH_IK_BUDGET = 0.5  # s per IK call while ranking candidates: a safety net; the iteration bound binds
-MAX_APPROACH_JUMP = 1.0  # rad: pre-grasp and grasp IK answers further apart are not one straight approach
-FAILED_NEAR = 0.015  # m: candidates this close to a failed grasp (same object pose) are skipped
-HALF_TURN = np.diag([1.0, -1.0, -1.0])  # about the approach axis: the same parallel-jaw grasp
-# Bullet lets a lying cylinder creep and roll away on a level plane (measured: 10 cm in 3 s from
-# rest); a little rolling/spinning friction (m) stops that artefact without changing the grasp.
-ROLLING_FRICTION = 1e-3
+__all__ = ["EpisodeFailed", "EpisodeSetup", "GraspRunner", "episode_setup", "episode_setups", "run_grasp"]
 
 
-EpisodeFailed = PhaseFailed  # perception or planning found nothing to try
+def episode_setup(params: GraspParams, seed: int, k: int) -> EpisodeSetup:
+    """Episode k: ``objects[k % n]`` moved by ``randomize`` with ``default_rng([seed, k])``."""
+    from robocfg.geometry import matrix_to_quat, quat_to_matrix
 
-
-@dataclass(frozen=True)
-class EpisodeSetup:
-    index: int
-    seed: int
-    body: Body
-    yaw: float  # rad, added to the object's own yaw
+    rz = params.randomize
+    obj = params.objects[k % len(params.objects)]
+    rng = episode_rng(seed, k)
+    dx, dy = rng.uniform(-1, 1, 2) * np.asarray(rz.xy_range)
+    dyaw = math.radians(rng.uniform(-1, 1) * rz.yaw_range_deg)
+    c, s_ = math.cos(dyaw), math.sin(dyaw)
+    Rz = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+    quat = matrix_to_quat(Rz @ quat_to_matrix(obj.quaternion_xyzw()))
+    body = obj.model_copy(update={
+        "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
+        "euler_deg": None, "quat_wxyz": None, "quat_xyzw": [float(v) for v in quat],
+    })
+    return EpisodeSetup(k, seed + k, body, dyaw)
 
 
 def episode_setups(params: GraspParams, seed: int, episodes: int) -> list[EpisodeSetup]:
-    """Episode k: ``objects[k % n]`` moved by ``randomize`` with ``default_rng([seed, k])``."""
-    out = []
-    rz = params.randomize
-    for k in range(episodes):
-        obj = params.objects[k % len(params.objects)]
-        rng = np.random.default_rng([seed, k])
-        dx, dy = rng.uniform(-1, 1, 2) * np.asarray(rz.xy_range)
-        dyaw = math.radians(rng.uniform(-1, 1) * rz.yaw_range_deg)
-        from robocfg.geometry import matrix_to_quat, quat_to_matrix
-
-        c, s_ = math.cos(dyaw), math.sin(dyaw)
-        Rz = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
-        quat = matrix_to_quat(Rz @ quat_to_matrix(obj.quaternion_xyzw()))
-        body = obj.model_copy(update={
-            "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
-            "euler_deg": None, "quat_wxyz": None, "quat_xyzw": [float(v) for v in quat],
-        })
-        out.append(EpisodeSetup(k, seed + k, body, dyaw))
-    return out
+    return [episode_setup(params, seed, k) for k in range(episodes)]
 
 
-def run_grasp(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm: str | None = None,
-              record=None, record_episode: int = 0, log: Log | None = None, save_cloud=None,
+@dataclass(frozen=True)
+class GraspOptions:
+    """``run grasp``'s own options."""
+
+    save_cloud: Path | None = field(default=None, metadata=option(
+        "--save-cloud", output=(".npz", ".ply"), help="Write the first object cloud (.npz or .ply)."))
+
+
+class GraspSession(EpisodeSession[GraspEpisode]):
+    """The grasp world, the measured gripper boxes, IK model and limits, shared by every episode."""
+
+    def __init__(self, task, options: RunOptions, on_cloud: Callable[[Any], None] | None = None):
+        self.on_cloud = on_cloud  # called with the first processed object cloud
+        super().__init__(task, options, GraspTiming())
+
+    def prepare(self) -> None:
+        from robocfg.grasp.gripper_model import measure_gripper
+
+        self.params: GraspParams = self.task.config.grasp  # type: ignore[union-attr]
+        self.arm_cfg = self.task.robots[0].config.arm(self.options.arm)
+        handle = self.world.robot.arm(self.arm_cfg.name)
+        if self.params.grip_force is not None:
+            handle.require_gripper().set_force(self.params.grip_force)
+        self.boxes = measure_gripper(self.world.robot, handle)  # moves the fingers: before the snapshot
+        self.ctx = self._context()
+
+    def _context(self) -> _Context:
+        """What episodes share besides the world (none of it touches the physics)."""
+        from robocfg.kinematics.model import KinematicModel
+        from robocfg.motion.limits import limits_from_robot
+
+        robot = self.task.robots[0]
+        handle = self.world.robot.arm(self.arm_cfg.name)
+        model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
+        bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
+        scale = self.params.speed_scale
+        assert isinstance(self.timing, GraspTiming)
+        return _Context(world=self.world, arm=handle, params=self.params, model=model,
+                        limits=limits_from_robot(robot, handle.joints, Limits(velocity_scale=scale, acceleration_scale=scale)),
+                        shake_limits=limits_from_robot(robot, handle.joints, Limits()),
+                        boxes=self.boxes, timing=self.timing, save_cloud=self.on_cloud)
+
+    def episode(self, k: int, recorder: FrameRecorder | None) -> GraspEpisode:
+        setup = episode_setup(self.params, self.seed, k)
+        self.remove_after_episode(setup.body.name)
+        return _Episode(self.ctx, setup, recorder, self.log_for(k)).run()
+
+    def make_recorder(self, path: Any) -> FrameRecorder:
+        from robocfg.grasp.draw import GraspRecorder
+        from robocfg.sim.record import CameraView
+
+        return GraspRecorder(self.world, path, fps=12.0, camera=CameraView(target=(0.5, 0.0, 0.08), distance=0.7,
+                                                                           yaw_deg=50.0, pitch_deg=-30.0))
+
+    def report(self, records: list[GraspEpisode], interrupted: bool) -> GraspReport:
+        from robocfg.grasp.perception import camera_warnings
+
+        warnings = [w.format() for w in self.task.warnings] + camera_warnings(self.params)
+        return GraspReport(task=str(self.task.path), robot=self.task.robots[0].config.name, arm=self.arm_cfg.name,
+                           seed=self.seed, summary=summarise(records), episodes=records, warnings=warnings,
+                           interrupted=interrupted)
+
+
+def _cloud_saver(path: Path) -> Callable[[Any], None]:
+    def save(cloud: Any) -> None:
+        from robocfg.grasp.cloud import save_cloud
+
+        save_cloud(cloud, path)
+
+    return save
+
+
+@register_task
+class GraspRunner(EpisodicRunner):
+    kind = "grasp"
+    params = GraspParams
+    report = GraspReport
+    Options = GraspOptions
+    verb = "lifted"
+    summary = ("Perceive the object with RGB-D cameras, plan antipodal grasps on the point cloud, execute the "
+               "best, lift, shake and verify; retry the next-ranked grasp on failure.")
+    description = (
+        "Grasp → EE by R_ee_graspnet, ee_axis, tcp_offset. Episode k grasps objects[k % n]. Exit 0 when the "
+        "lift success rate reaches --min-success, 1 otherwise (no object points in the workspace, no feasible "
+        "grasp, or the object was not held). --record draws the candidate grasps.")
+
+    def check(self) -> None:
+        super().check()
+        task = self.task
+        params: GraspParams = task.config.grasp  # type: ignore[union-attr]
+        if not params.objects:
+            raise ConfigError([task.doc.problem(("grasp", "objects"), "no objects to grasp: give at least one")])
+        robot = task.robots[0]
+        arm_cfg = robot.config.arm(self.options.arm)
+        if not isinstance(arm_cfg.gripper, ParallelGripperConfig):
+            raise RobocfgError(f"run grasp plans two-finger antipodal grasps; arm {arm_cfg.name!r} of robot "
+                               f"{robot.config.name!r} has a {arm_cfg.gripper.type if arm_cfg.gripper else 'no'!r} gripper")
+        extras = self.options.extras
+        if isinstance(extras, GraspOptions) and extras.save_cloud is not None \
+                and extras.save_cloud.suffix.lower() not in (".npz", ".ply"):
+            raise ConfigError([Problem("--save-cloud", None, None, "",
+                                       f"needs a .npz or .ply file name, got {extras.save_cloud.name!r}")])
+
+    def open_session(self) -> GraspSession:
+        extras = self.options.extras
+        on_cloud = self.on_cloud
+        if on_cloud is None and isinstance(extras, GraspOptions) and extras.save_cloud is not None:
+            on_cloud = _cloud_saver(extras.save_cloud)
+        return GraspSession(self.task, self.options, on_cloud)
+
+    on_cloud: Callable[[Any], None] | None = None  # overrides --save-cloud (Python callers)
+
+
+def run_grasp(task, episodes: int = 1, seed: int | None = None, arm: str | None = None,
+              record: Callable[[Any], FrameRecorder] | None = None, record_episode: int = 0,
+              log: Callable[[str], None] | None = None, save_cloud: Callable[[Any], None] | None = None,
               on_episode: Callable[[GraspEpisode], None] | None = None,
               should_stop: Callable[[], bool] | None = None) -> tuple[GraspReport, GraspTiming]:
-    """Run ``episodes`` episodes in one world (restored to the same snapshot before each).
-
-    ``record``: ``world -> GraspRecorder`` used for episode ``record_episode``; ``save_cloud``:
-    ``Cloud -> None`` called with the first processed cloud; ``log``: phase log of episode 0;
-    ``should_stop``: asked before each episode, True ends the run with an ``interrupted`` report.
-    """
-    from robocfg.grasp.gripper_model import measure_gripper
-    from robocfg.grasp.perception import camera_warnings
-    from robocfg.kinematics.model import KinematicModel
-    from robocfg.motion.limits import limits_from_robot
-    from robocfg.sim.world import World
-
-    params: GraspParams = task.config.grasp  # type: ignore[union-attr]
-    if not params.objects:
-        raise EpisodeFailed("setup", "grasp.objects is empty: nothing to grasp")
-    seed = task.config.sim.seed if seed is None else seed
-    robot = task.robots[0]
-    arm_cfg = robot.config.arm(arm)
-    if not isinstance(arm_cfg.gripper, ParallelGripperConfig):
-        raise RobocfgError(f"run grasp plans two-finger antipodal grasps; arm {arm_cfg.name!r} of robot "
-                           f"{robot.config.name!r} has a {arm_cfg.gripper.type!r} gripper")
-    warnings = [w.format() for w in task.warnings] + camera_warnings(params)
-    results, timing = [], GraspTiming()
-    t_all = time.perf_counter()
-    with World(task) as world:
-        world.step(1)
-        handle = world.robot.arm(arm_cfg.name)
-        if params.grip_force is not None and hasattr(handle.gripper, "set_force"):
-            handle.gripper.set_force(params.grip_force)
-        boxes = measure_gripper(world.robot, handle)  # moves the fingers: before the snapshot
-        state = world.snapshot()
-        model = KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=world.robot.base_pose())
-        bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
-        ctx = _Context(
-            world=world, arm=handle, params=params, model=model,
-            limits=limits_from_robot(robot, handle.joints, Limits(velocity_scale=params.speed_scale,
-                                                                  acceleration_scale=params.speed_scale)),
-            shake_limits=limits_from_robot(robot, handle.joints, Limits()),
-            boxes=boxes, timing=timing, save_cloud=save_cloud,
-        )
-        spawned: str | None = None
-        interrupted = False
-        for setup in episode_setups(params, seed, episodes):
-            if should_stop is not None and should_stop():
-                interrupted = True
-                break
-            t0 = time.perf_counter()
-            if spawned is not None and spawned in world.bodies:
-                world.remove_body(spawned)
-            world.restore(state)
-            spawned = setup.body.name
-            recorder = record(world) if (record is not None and setup.index == record_episode) else None
-            ep = _Episode(ctx, setup, recorder, log if setup.index == 0 else None)
-            res = ep.run()
-            if recorder is not None:
-                recorder.save()
-            timing.per_episode.append(time.perf_counter() - t0)
-            results.append(res)
-            if on_episode:
-                on_episode(res)
-    timing.wall_time = time.perf_counter() - t_all
-    report = GraspReport(task=str(task.path), robot=robot.config.name, arm=arm_cfg.name, seed=seed,
-                         summary=summarise(results), episodes=results, warnings=warnings, interrupted=interrupted)
-    return report, timing
-
-
-@dataclass
-class _Context:
-    """Per-run objects shared by every episode."""
-
-    world: object
-    arm: object
-    params: GraspParams
-    model: object
-    limits: object
-    shake_limits: object
-    boxes: object
-    timing: GraspTiming
-    save_cloud: Callable | None
-
-
-class _Episode:
-    def __init__(self, ctx: _Context, setup: EpisodeSetup, recorder, log: Log | None):
-        self.ctx, self.setup, self.recorder = ctx, setup, recorder
-        self.world, self.arm, self.params = ctx.world, ctx.arm, ctx.params
-        self.log = log or (lambda _msg: None)
-        self.rng = np.random.default_rng([setup.seed, 7])
-        self.mover = ArmMover(self.world, self.arm, ctx.model, ctx.limits, self.params.position_tolerance,
-                              self.params.orientation_tolerance, self.params.phase_timeout, self._on_step)
-        self.obj = self.world.add_body(setup.body)
-        import pybullet as pb
-
-        pb.changeDynamics(self.obj, -1, rollingFriction=ROLLING_FRICTION, spinningFriction=ROLLING_FRICTION,
-                          physicsClientId=self.world.client)
-        self.attempts: list[AttemptRecord] = []
-        self.failed: list[Grasp] = []
-        self.first_plan: PlanResult | None = None
-        self.n_points = 0
-        self.lift_rise: float | None = None
-
-    # ---- episode -----------------------------------------------------------------------------
-    def run(self) -> GraspEpisode:
-        failed, reason = None, "lifted"
-        try:
-            self.mover.settle(SPAWN_SETTLE)
-            for k in range(self.params.max_attempts):
-                cand = self._plan(k)
-                try:
-                    self._execute(cand, k)
-                    self.attempts.append(AttemptRecord(cand.to_dict(), k, True, None, "lifted"))
-                    failed, reason = None, "lifted"
-                    break
-                except MoveFailed as exc:
-                    self.log(f"  attempt {k + 1} failed: {exc.phase}: {exc.reason}")
-                    self.attempts.append(AttemptRecord(cand.to_dict(), k, False, exc.phase, exc.reason))
-                    self.failed.append(cand.grasp)
-                    failed, reason = exc.phase, exc.reason
-                    self._recover()
-        except PhaseFailed as exc:  # nothing to try (perception, planning), or recovery itself failed
-            failed, reason = exc.phase, exc.reason
-        return self._result(failed, reason)
-
-    def _plan(self, attempt: int) -> Candidate:
-        from robocfg.grasp.perception import perceive
-
-        p, ctx = self.params, self.ctx
-        t0 = time.perf_counter()
-        per = perceive(self.world, p, self.rng)
-        ctx.timing.perception.append(time.perf_counter() - t0)
-        if attempt == 0:
-            self.n_points = len(per.objects)
-            if ctx.save_cloud is not None:
-                ctx.save_cloud(per.objects)
-                ctx.save_cloud = None
-        if len(per.objects) < p.min_object_points:
-            raise EpisodeFailed("perception", f"no object points in the workspace ({len(per.objects)} after "
-                                              f"cropping to {p.workspace.min}..{p.workspace.max}, need ≥ {p.min_object_points})")
-        settings = PlannerSettings(mu=p.friction, num_candidates=p.num_candidates, top_k=p.top_k,
-                                   standoff=p.pre_grasp_distance, voxel=p.voxel_size)
-        t0 = time.perf_counter()
-        plan = plan_grasps(per.objects.points, per.objects.normals, per.scene, per.support_z, ctx.boxes,
-                           settings, self.rng, reach=self._reach, curvature=per.objects.curvature)
-        ctx.timing.planning.append(time.perf_counter() - t0)
-        if self.first_plan is None:
-            self.first_plan = plan
-        usable = [c for c in plan.candidates if not any(np.linalg.norm(c.grasp.center - f.center) < FAILED_NEAR
-                                                       and _same_axis(c.grasp, f) for f in self.failed)]
-        if self.recorder is not None and hasattr(self.recorder, "show"):
-            self.recorder.show([c.grasp for c in plan.candidates], self.ctx.boxes)
-        self.log(f"Plan {attempt + 1}: {len(per.objects)} object points, {plan.poses} poses, "
-                 f"{len(plan.candidates)} reachable candidates, best score "
-                 f"{plan.candidates[0].score if plan.candidates else float('nan'):.3f} ({plan.time_s:.2f} s)")
-        if not usable:
-            counts = ", ".join(f"{k} {v}" for k, v in plan.rejected.items() if v)
-            why = "every reachable candidate already failed" if plan.candidates else "no feasible grasp"
-            raise EpisodeFailed("planning", f"{why}: {plan.seeds} seeds, {plan.poses} poses; rejected: "
-                                            f"{counts or 'none'}; {plan.suppressed} duplicates suppressed")
-        return usable[0]
-
-    def _reach(self, g: Grasp) -> tuple[Grasp, np.ndarray] | None:
-        """The half turn of ``g`` nearer the current wrist first; IK of the pre-grasp and the grasp."""
-        cfg, model = self.arm.config, self.ctx.model
-        R_now = self.arm.ee_pose()[:3, :3]
-        R_eg = np.asarray(cfg.R_ee_graspnet, float)
-        flips = [g, Grasp(g.center, g.rotation @ HALF_TURN, g.width)]
-        flips.sort(key=lambda h: rotation_angle(R_now, h.rotation @ R_eg))
-        q_now = self.arm.joint_positions()
-        for h in flips:
-            pre = model.ik(ee_pose_from_grasp(h, cfg, standoff=self.params.pre_grasp_distance), seed_q=q_now,
-                           frame="ee", time_budget=REACH_IK_BUDGET)
-            if not pre.converged:
-                continue
-            at = model.ik(ee_pose_from_grasp(h, cfg), seed_q=pre.q, frame="ee", time_budget=REACH_IK_BUDGET)
-            if at.converged and np.max(np.abs(at.q - pre.q)) < MAX_APPROACH_JUMP:
-                return h, pre.q
-        return None
-
-    def _execute(self, cand: Candidate, attempt: int) -> None:
-        p, m, cfg = self.params, self.mover, self.arm.config
-        g = cand.grasp
-        T_grasp = ee_pose_from_grasp(g, cfg)
-        T_pre = ee_pose_from_grasp(g, cfg, standoff=p.pre_grasp_distance)
-        self._phase("pre_grasp", f"attempt {attempt + 1}: score {cand.score:.3f}, width {g.width * 1000:.0f} mm")
-        self.arm.gripper.open()
-        m.move(T_pre, straight=False, q_goal=cand.q)
-        self._phase("approach", "straight along the approach")
-        m.move(T_grasp, straight=True)
-        self._phase("grasp", "close the gripper")
-        m.close_until_held(self.obj, timeout=1.5)
-        self._phase("lift", f"lift {p.lift_height * 100:.0f} cm")
-        z0 = self.world.body_pose(self.obj)[0][2]
-        T_lift = T_grasp.copy()
-        T_lift[2, 3] += p.lift_height
-        m.move(T_lift, straight=True)
-        self._check_lifted(z0, "lift")
-        if p.shake:
-            self._phase("shake", f"±{p.shake_amplitude * 100:.0f} cm along y, twice")
-            m.limits = self.ctx.shake_limits
-            try:
-                for dy in (p.shake_amplitude, -p.shake_amplitude, p.shake_amplitude, -p.shake_amplitude, 0.0):
-                    T = T_lift.copy()
-                    T[1, 3] += dy
-                    m.move(T, straight=True)
-            finally:
-                m.limits = self.ctx.limits
-            m.settle(0.3)
-            self._check_lifted(z0, "shake")
-
-    def _check_lifted(self, z0: float, phase: str) -> None:
-        z1 = self.world.body_pose(self.obj)[0][2]
-        self.lift_rise = float(z1 - z0)
-        if not self.arm.gripper.is_grasping(self.obj) or self.lift_rise < 0.5 * self.params.lift_height:
-            raise MoveFailed(phase, f"object not held (rose {self.lift_rise * 100:.1f} cm of {self.params.lift_height * 100:.0f})")
-
-    def _recover(self) -> None:
-        """Open, back off along the approach (or straight up), return home, let the object settle."""
-        m = self.mover
-        m.phase = "recover"
-        m.open_gripper(0.3)
-        T = self.arm.ee_pose()
-        T[2, 3] += 0.1
-        with contextlib.suppress(MoveFailed):  # going home in joint space is still safe from most poses
-            m.move(T, straight=True)
-        home = self.arm.home
-        m.move(self.ctx.model.fk(home, "ee"), straight=False, q_goal=home)
-        m.settle(0.3)
-
-    def _phase(self, name: str, what: str) -> None:
-        self.mover.phase = name
-        self.log(f"Phase {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
-
-    def _on_step(self) -> None:
-        if self.recorder is not None:
-            self.recorder.maybe_capture()
-
-    def _result(self, failed: str | None, reason: str) -> GraspEpisode:
-        s, plan = self.setup, self.first_plan
-        b = s.body
-        chosen = self.attempts[-1].candidate["score"] if self.attempts else None
-        return GraspEpisode(
-            index=s.index, seed=s.seed, object=b.name,
-            object_start=[round(float(v), 6) for v in b.position],
-            object_start_yaw_deg=round(math.degrees(s.yaw), 4),
-            success=failed is None and bool(self.attempts) and self.attempts[-1].success,
-            first_attempt_success=bool(self.attempts) and self.attempts[0].success,
-            failed_phase=failed, reason=reason, object_points=self.n_points,
-            poses_evaluated=plan.poses if plan else 0, candidates=len(plan.candidates) if plan else 0,
-            rejected=dict(plan.rejected) if plan else {}, chosen_score=chosen,
-            lift_rise=None if self.lift_rise is None else round(self.lift_rise, 6),
-            sim_time=round(self.world.t, 6), attempts=self.attempts)
-
-
-def _same_axis(a: Grasp, b: Grasp) -> bool:
-    return abs(float(a.closing() @ b.closing())) > math.cos(math.radians(20)) and float(a.approach() @ b.approach()) > math.cos(math.radians(20))
+    """Keyword form of ``GraspRunner(task, RunOptions(...)).run()`` for scripts and benchmarks:
+    (report, timing). ``save_cloud`` is called with the first processed cloud."""
+    runner = GraspRunner(task, RunOptions(seed=seed, episodes=episodes, arm=arm, recorder=record,
+                                          record_episode=record_episode, log=log, on_episode=on_episode,  # type: ignore[arg-type]
+                                          should_stop=should_stop))
+    runner.check()
+    runner.on_cloud = save_cloud
+    out = runner.run()
+    assert isinstance(out.timing, GraspTiming)
+    return out.report, out.timing

@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from robocfg.engine.runner import EpisodesReport, ReportView
+from robocfg.engine.session import BatchTiming
 from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
 
@@ -58,7 +60,7 @@ class GraspSummary:
 
 
 @dataclass
-class GraspReport:
+class GraspReport(EpisodesReport):
     """The ``--json`` report. ``interrupted``: the run was stopped (SIGINT/SIGTERM) and
     ``episodes`` holds only the episodes that finished."""
 
@@ -72,16 +74,46 @@ class GraspReport:
     warnings: list[str] = field(default_factory=list)
     interrupted: bool = False
 
+    def summary_line(self, timing: BatchTiming | None) -> str:
+        s = self.summary
+        ok = "ok" if s.successes == s.episodes else "failed"
+        plan = f", planning median {timing.median_planning:.2f} s" if isinstance(timing, GraspTiming) else ""
+        return f"{ok}: {self.robot} lifted {s.successes}/{s.episodes} ({s.success_rate:.1%}){plan}"
+
+    def view(self, timing: BatchTiming | None) -> ReportView:
+        s = self.summary
+        failed = [e for e in self.episodes if not e.success]
+        rows = [("episodes", str(s.episodes)),
+                ("lift success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%}); first attempt {s.first_attempt_rate:.1%}"),
+                ("by object", ", ".join(f"{k} {v}" for k, v in s.by_object.items())),
+                ("failures by phase", ", ".join(f"{k}: {v}" for k, v in s.failures_by_phase.items()) or "none")]
+        if isinstance(timing, GraspTiming):
+            rows += [("planning time (median)", f"{timing.median_planning:.3f} s over {len(timing.planning)} plans"),
+                     ("perception time (median)", f"{timing.median_perception:.3f} s (render + cloud)"),
+                     ("wall time / episode", f"{timing.mean_episode:.2f} s")]
+        if s.episodes == 1:
+            e = self.episodes[0]
+            rows += [("object points", str(e.object_points)), ("poses evaluated", str(e.poses_evaluated)),
+                     ("reachable candidates", str(e.candidates)),
+                     ("rejected", ", ".join(f"{k} {v}" for k, v in e.rejected.items() if v) or "none"),
+                     ("chosen score", "-" if e.chosen_score is None else f"{e.chosen_score:.3f}"),
+                     ("attempts", str(len(e.attempts)))]
+        footer = []
+        if failed:
+            footer.append(f"failed episodes: {', '.join(f'{e.index} ({e.object})' for e in failed[:20])}"
+                          f"{' ...' if len(failed) > 20 else ''} (seeds and details in --json)")
+        return ReportView(f"run grasp: {self.robot} (arm {self.arm}), seed {self.seed}", rows,
+                          warnings=list(self.warnings), failures=self.failure_lines(), footer=footer,
+                          status="failed" if failed else "ok")
+
 
 @dataclass
-class GraspTiming:
+class GraspTiming(BatchTiming):
     """Wall times (s): ``planning`` per plan (sampling → ranked reachable grasps), ``perception``
-    per capture (rendering + cloud), ``per_episode``, ``wall_time`` overall."""
+    per capture (rendering + cloud), besides the batch's ``per_episode`` and ``wall_time``."""
 
     planning: list[float] = field(default_factory=list)
     perception: list[float] = field(default_factory=list)
-    per_episode: list[float] = field(default_factory=list)
-    wall_time: float = 0.0
 
     @property
     def median_planning(self) -> float:

@@ -10,16 +10,20 @@ Phases: ``settle`` (home, gripper open) → per cycle ``close`` and ``open`` (ea
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import GripperParams
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
-from robocfg.errors import RobocfgError, RunFailed
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.engine.registry import register_task
+from robocfg.engine.runner import RunOutput, TaskRunner
+from robocfg.errors import RobocfgError, RunFailed, RunInterrupted
+from robocfg.runners.gripper_report import GripperResult, HoldTest, Move, _mm
+
+__all__ = ["GripperResult", "GripperRunner", "HoldTest", "Move", "run_gripper"]
 
 SETTLE_TIME = 0.25  # s
 SETTLE_TOL_FRACTION = 0.02  # of max_width − min_width, at least SETTLE_TOL_MIN
@@ -31,73 +35,14 @@ SUPPORT_LOWER_TIME = 0.5  # s
 HOLD_WAIT = 0.5  # s after the support has gone
 
 
-@dataclass
-class Move:
-    """One close or open command."""
-
-    phase: str
-    cycle: int
-    t_start: float  # s, simulated
-    width_start: float | None  # m (None for suction)
-    width_end: float | None  # m
-    settle_time: float | None  # s from the command until the width stays within tolerance of width_end
-    state_end: float  # 1.0 open / −1.0 closed
-    mimic_max_error: float  # rad or m, worst follower error during the move
-
-
-@dataclass
-class HoldTest:
-    object: str
-    support_lowered_by: float  # m (0: support removed)
-    grasping_before: bool  # both fingers touch the object after closing
-    grasping_after: bool
-    width_on_object: float | None  # m (None for suction)
-    drop: float  # m the object sank while the support went away
-    held: bool
-    released: bool  # the object left the fingers after opening
-
-
-@dataclass
-class GripperResult:
-    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
-    task: str
-    robot: str
-    arm: str
-    gripper_type: str
-    mode: str
-    dt: float
-    cycles: int
-    min_width: float
-    max_width: float
-    success: bool = False
-    failed_phase: str | None = None
-    reason: str | None = None
-    samples: list[tuple[float, float | None]] = field(default_factory=list)  # (t s, measured width m)
-    moves: list[Move] = field(default_factory=list)
-    time_to_close: float | None = None  # s, worst over cycles
-    time_to_open: float | None = None
-    final_closed_width: float | None = None
-    final_open_width: float | None = None
-    width_change: float | None = None  # m, open − closed (free, last cycle)
-    mimic_max_error: float = 0.0
-    hold: HoldTest | None = None
-    warnings: list[str] = field(default_factory=list)
-    sim_time: float = 0.0
-    wall_time: float = 0.0
-    record: str | None = None
-
-    def to_dict(self) -> dict:
-        return asdict(self)
-
-
 class _Run:
-    def __init__(self, world, params: GripperParams, result: GripperResult, recorder):
+    def __init__(self, world, params: GripperParams, result: GripperResult, recorder, arm: str | None):
         self.world, self.params, self.result, self.recorder = world, params, result, recorder
-        self.arm = world.robot.arm()
+        self.arm = world.robot.arm(arm)
         self.gripper = self.arm.gripper
 
     def width(self) -> float | None:
-        return self.gripper.width() if hasattr(self.gripper, "width") else None
+        return self.gripper.width()
 
     def run_for(self, seconds: float, each=None) -> float:
         """Step for ``seconds``; returns the worst mimic error seen."""
@@ -129,9 +74,9 @@ class _Run:
         widths = [s[1] for s in self.result.samples[k0:]]
         w_end, settle = widths[-1], None
         if w_end is not None:
-            cfg = g.config
-            tol = max(SETTLE_TOL_MIN, SETTLE_TOL_FRACTION * (cfg.max_width - cfg.min_width))
-            outside = [k for k, v in enumerate(widths) if abs(v - w_end) > tol]
+            travel = self.result.max_width - self.result.min_width
+            tol = max(SETTLE_TOL_MIN, SETTLE_TOL_FRACTION * travel)
+            outside = [k for k, v in enumerate(widths) if v is None or abs(v - w_end) > tol]
             if not outside:
                 settle = w.dt
             elif (len(widths) - 1 - outside[-1]) * w.dt >= SETTLE_TAIL:
@@ -141,33 +86,56 @@ class _Run:
         return m
 
 
+@register_task
+class GripperRunner(TaskRunner):
+    kind = "gripper"
+    params = GripperParams
+    report = GripperResult
+    summary = "Close then open the arm's gripper; report measured widths, timing, mimic error and the hold test."
+
+    def check(self) -> None:
+        super().check()
+        robot_cfg = self.task.robots[0].config
+        arm_cfg = robot_cfg.arm(self.options.arm)
+        if arm_cfg.gripper is None:
+            raise RobocfgError(f"robot {robot_cfg.name!r} has no gripper (arm {arm_cfg.name!r} gripper is missing "
+                               f"in {self.task.robots[0].path})")
+
+    def run(self) -> RunOutput:
+        o = self.options
+        return RunOutput(run_gripper(self.task, gui=o.gui, record=o.record, arm=o.arm, should_stop=o.should_stop))
+
+
 def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None,
-                camera=None, fps: float = 10.0) -> GripperResult:
-    """Run the gripper task; returns the result or raises RunFailed carrying it."""
+                camera=None, fps: float = 10.0, arm: str | None = None, should_stop=None) -> GripperResult:
+    """Run the gripper task; returns the result or raises RunFailed carrying it. ``should_stop``
+    (SIGINT) ends the run early with the result marked ``interrupted``."""
     from robocfg.sim.record import Recorder, facing_camera
     from robocfg.sim.world import World
 
     params: GripperParams = task.config.gripper  # type: ignore[union-attr]
     robot_cfg = task.robots[0].config
-    arm_cfg = robot_cfg.arms[0]
+    arm_cfg = robot_cfg.arm(arm)
     g_cfg = arm_cfg.gripper
     if g_cfg is None:
-        raise RobocfgError(f"robot {robot_cfg.name!r} has no gripper (arms[0].gripper is missing in {task.robots[0].path})")
+        raise RobocfgError(f"robot {robot_cfg.name!r} has no gripper (arm {arm_cfg.name!r} gripper is missing in {task.robots[0].path})")
     t_wall = time.perf_counter()
     with World(task, gui=gui) as world:
+        world.should_stop = should_stop
         result = GripperResult(
             task=str(task.path), robot=robot_cfg.name, arm=arm_cfg.name, gripper_type=g_cfg.type,
             mode=params.mode, dt=world.dt, cycles=params.cycles,
-            min_width=getattr(g_cfg, "min_width", 0.0), max_width=getattr(g_cfg, "max_width", 0.0))
+            min_width=g_cfg.min_width if isinstance(g_cfg, ParallelGripperConfig) else 0.0,
+            max_width=g_cfg.max_width if isinstance(g_cfg, ParallelGripperConfig) else 0.0)
         result.warnings = [p.format() for p in task.warnings] + list(world.warnings)
         recorder = None
         if record is not None:
-            arm = world.robot.arm()
-            tcp = arm.tcp_pose()
-            closing = tcp[:3, :3] @ np.asarray(arm.config.R_ee_graspnet)[1, :]  # grasp y in world
+            handle = world.robot.arm(arm_cfg.name)
+            tcp = handle.tcp_pose()
+            closing = tcp[:3, :3] @ np.asarray(handle.config.R_ee_graspnet)[1, :]  # grasp y in world
             view = camera or facing_camera(tcp[:3, 3], closing, world.robot.base_pose()[:3, 3], distance=0.35)
             recorder = Recorder(world, record, fps=fps, camera=view)
-        run = _Run(world, params, result, recorder)
+        run = _Run(world, params, result, recorder, arm_cfg.name)
         if g_cfg.type == "parallel":
             run.gripper.rate = params.rate if params.mode == "smooth" else None
         try:
@@ -176,6 +144,8 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
             else:
                 _suction(run)
             result.success = True
+        except RunInterrupted as exc:
+            result.interrupted, result.failed_phase, result.reason = True, exc.phase, exc.reason
         except RunFailed as exc:
             result.failed_phase, result.reason = exc.phase, exc.reason
             raise RunFailed(exc.phase, exc.reason, report=result) from None
@@ -188,25 +158,33 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
 
 
 def _parallel(run: _Run) -> None:
-    res, cfg, g = run.result, run.gripper.config, run.gripper
+    res, g = run.result, run.gripper
     run.run_for(SETTLE_TIME)
-    travel = cfg.max_width - cfg.min_width
+    travel = res.max_width - res.min_width
     for cycle in range(run.params.cycles):
         c = run.move("close", cycle, g.close)
         o = run.move("open", cycle, g.open)
-        res.final_closed_width, res.final_open_width = c.width_end, o.width_end
-        res.width_change = o.width_end - c.width_end
+        closed, opened = _measured(c.width_end, "close"), _measured(o.width_end, "open")
+        res.final_closed_width, res.final_open_width = closed, opened
+        res.width_change = change = opened - closed
         res.time_to_close = _worst(res.time_to_close, c.settle_time)
         res.time_to_open = _worst(res.time_to_open, o.settle_time)
         if c.settle_time is None:
-            raise RunFailed("close", f"width still changing after {run.move_time():.2f} s (now {c.width_end * 1000:.1f} mm)")
+            raise RunFailed("close", f"width still changing after {run.move_time():.2f} s (now {closed * 1000:.1f} mm)")
         if o.settle_time is None:
-            raise RunFailed("open", f"width still changing after {run.move_time():.2f} s (now {o.width_end * 1000:.1f} mm)")
-        if res.width_change < WIDTH_CHANGE_MIN * travel:
-            raise RunFailed("close", f"measured width changed by {res.width_change * 1000:.1f} mm, less than "
+            raise RunFailed("open", f"width still changing after {run.move_time():.2f} s (now {opened * 1000:.1f} mm)")
+        if change < WIDTH_CHANGE_MIN * travel:
+            raise RunFailed("close", f"measured width changed by {change * 1000:.1f} mm, less than "
                                      f"{WIDTH_CHANGE_MIN:.0%} of max_width − min_width ({travel * 1000:.1f} mm)")
     if run.params.hold_object:
         _hold_test(run)
+
+
+def _measured(width: float | None, phase: str) -> float:
+    """A finger gap (m) that a parallel gripper must report."""
+    if width is None:
+        raise RunFailed(phase, "the gripper reports no finger width")
+    return width
 
 
 def _worst(a: float | None, b: float | None) -> float | None:
@@ -220,6 +198,8 @@ def _place_object(run: _Run, at: np.ndarray, R: np.ndarray):
     from robocfg.geometry import matrix_to_quat
 
     w, name = run.world, run.params.hold_object
+    if name is None:
+        raise RunFailed("place", "no gripper.hold_object to place")
     spec = next((b for b in w.task.config.scene.objects if b.name == name), None)
     if spec is None:
         known = [b.name for b in w.task.config.scene.objects]
@@ -234,10 +214,8 @@ def _place_object(run: _Run, at: np.ndarray, R: np.ndarray):
 
 
 def _half_extent_z(world, name: str) -> float:
-    import pybullet as p
-
-    lo, hi = p.getAABB(world.bodies[name], physicsClientId=world.client)
-    return (hi[2] - lo[2]) / 2
+    lo, hi = world.aabb(name)
+    return float(hi[2] - lo[2]) / 2
 
 
 def _footprint(b: Body) -> list[float]:
@@ -274,7 +252,7 @@ def _hold_test(run: _Run) -> None:
     hold = HoldTest(name, run.params.lift_support_by, grasp_before, False, width_on, 0.0, False, False)
     res.hold = hold
     if not grasp_before:
-        raise RunFailed("grasp", f"the fingers do not both touch {name!r} after closing (width {width_on * 1000:.1f} mm)")
+        raise RunFailed("grasp", f"the fingers do not both touch {name!r} after closing (width {_mm(width_on)})")
     _lower_support(run, support)
     run.run_for(HOLD_WAIT)
     hold.drop = float(z0 - w.body_pose(name)[0][2])

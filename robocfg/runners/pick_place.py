@@ -1,388 +1,152 @@
-"""``run pick-place``: the 8-phase pick-and-place state machine, robot-agnostic.
+"""``run pick-place``: pick the task's object and place it, robot-agnostic, over seeded episodes.
 
-Every target comes from the robot YAML through one conversion (design.md §3): a top-down
-GraspNet grasp (approach straight down, fingers closing across the object's narrower horizontal
-side) → ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``) → IK (continuous
-along straight TCP lines) → min-jerk timed joint trajectories → position drives, all through
-:class:`robocfg.motion.moves.ArmMover`. With ``motion: reactive`` the two free-space moves
-(pre-grasp, transport) are driven by the follow-target controller instead
-(:mod:`robocfg.motion.reactive_drive`, built once per run), which keeps the arm and the held
-object clear of the scene's obstacles. The object is held by friction only (parallel grippers)
-or by the suction cup.
+Episode k randomises the object (position, yaw, mass, friction) and the place point with
+``default_rng([seed, k])`` and runs the 8-phase state machine of
+:mod:`robocfg.runners.pick_place_machine` in the session's world, restored before each episode.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import Limits, PickPlaceParams
-from robocfg.config.scene import Body
-from robocfg.geometry import rotation_angle
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, top_down_grasps
-from robocfg.motion.moves import ArmMover, MoveFailed, bound_ik_by_iterations
-from robocfg.runners.pick_place_report import (
-    EpisodeResult,
-    PhaseRecord,
-    PickPlaceReport,
-    PickPlaceTiming,
-    summarise,
-)
+from robocfg.engine.options import FrameRecorder, RunOptions, option
+from robocfg.engine.registry import register_task
+from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
+from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
+from robocfg.runners.pick_place_machine import EpisodeSetup, _StateMachine, _Tools, reactive_drive
+from robocfg.runners.pick_place_report import EpisodeResult, PickPlaceReport, summarise
 
-Log = Callable[[str], None]
-SETTLE_POLL = 4  # physics steps between checks while waiting
-RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
-SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
+__all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episode_setup", "episode_setups",
+           "run_pick_place"]
+
+PickPlaceTiming = BatchTiming
 
 
-@dataclass(frozen=True)
-class EpisodeSetup:
-    """What an episode randomised: object body, place point (m), seed."""
-
-    index: int
-    seed: int
-    body: Body
-    yaw: float  # rad
-    place_xy: np.ndarray
-
-
-def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[EpisodeSetup]:
-    """Randomised episode parameters, a fixed function of ``seed`` (episode k uses seed + k)."""
-    out = []
+def episode_setup(params: PickPlaceParams, seed: int, k: int) -> EpisodeSetup:
+    """Episode ``k``'s randomised object and place point, a fixed function of (seed, k)."""
     obj = params.object
     rz = params.randomize
     base_yaw = math.radians((obj.euler_deg or [0, 0, 0])[2])
-    for k in range(episodes):
-        rng = np.random.default_rng([seed, k])
-        dx, dy = (rng.uniform(-1, 1, 2) * np.asarray(rz.object.xy_range))
-        dyaw = math.radians(rng.uniform(-1, 1) * rz.object.yaw_range_deg)
-        px, py = (rng.uniform(-1, 1, 2) * np.asarray(rz.place.xy_range))
-        mass = obj.mass * (1 + rng.uniform(-1, 1) * rz.mass_scale)
-        friction = obj.friction * (1 + rng.uniform(-1, 1) * rz.friction_scale)
-        yaw = base_yaw + dyaw
-        roll, pitch = (obj.euler_deg or [0, 0, 0])[:2]
-        body = obj.model_copy(update={
-            "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
-            "euler_deg": [roll, pitch, math.degrees(yaw)], "quat_xyzw": None, "quat_wxyz": None,
-            "mass": mass, "friction": friction,
-        })
-        place = np.asarray(params.place_position[:2]) + np.array([px, py])
-        out.append(EpisodeSetup(k, seed + k, body, yaw, place))
-    return out
+    rng = episode_rng(seed, k)
+    dx, dy = (rng.uniform(-1, 1, 2) * np.asarray(rz.object.xy_range))
+    dyaw = math.radians(rng.uniform(-1, 1) * rz.object.yaw_range_deg)
+    px, py = (rng.uniform(-1, 1, 2) * np.asarray(rz.place.xy_range))
+    mass = obj.mass * (1 + rng.uniform(-1, 1) * rz.mass_scale)
+    friction = obj.friction * (1 + rng.uniform(-1, 1) * rz.friction_scale)
+    yaw = base_yaw + dyaw
+    roll, pitch = (obj.euler_deg or [0, 0, 0])[:2]
+    body = obj.model_copy(update={
+        "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
+        "euler_deg": [roll, pitch, math.degrees(yaw)], "quat_xyzw": None, "quat_wxyz": None,
+        "mass": mass, "friction": friction,
+    })
+    place = np.asarray(params.place_position[:2]) + np.array([px, py])
+    return EpisodeSetup(k, seed + k, body, yaw, place)
 
 
-def run_pick_place(task: CheckedTask, episodes: int = 1, seed: int | None = None, arm: str | None = None,
-                   gui: bool = False, record=None, record_episode: int = 0, log: Log | None = None,
-                   on_episode: Callable[[EpisodeResult], None] | None = None,
-                   sink=None, should_stop: Callable[[], bool] | None = None) -> tuple[PickPlaceReport, PickPlaceTiming]:
-    """Run ``episodes`` episodes in one world, restored to the same snapshot before each; returns
-    the report (deterministic for a seed) and wall times.
-
-    ``record`` is a callable ``world -> Recorder`` used for episode ``record_episode``; ``log``
-    receives the phase log of episode 0. ``sink`` (a :class:`robocfg.datasets.sink.DatasetSink`)
-    records every episode; its command gate then stands between the state machine and the drives.
-    ``should_stop`` is asked before each episode; once it answers True the run ends and the report
-    (of the finished episodes) says ``interrupted``.
-    """
-    from robocfg.kinematics.model import KinematicModel
-    from robocfg.motion.limits import limits_from_robot
-    from robocfg.sim.world import World
-
-    params: PickPlaceParams = task.config.pick_place  # type: ignore[union-attr]
-    seed = task.config.sim.seed if seed is None else seed
-    robot = task.robots[0]
-    arm_cfg = robot.config.arm(arm)
-    results, timing = [], PickPlaceTiming()
-    t_all = time.perf_counter()
-    with World(task, gui=gui) as world:
-        world.step(1)
-        state = world.snapshot()
-        handle = world.robot.arm(arm_cfg.name)
-        model = KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=world.robot.base_pose())
-        bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
-        tools = _Tools(
-            model,
-            limits_from_robot(robot, handle.joints, Limits(velocity_scale=params.speed_scale,
-                                                           acceleration_scale=params.speed_scale)),
-            _reactive_drive(robot, world, arm_cfg.name, params),
-        )
-        interrupted = False
-        for setup in episode_setups(params, seed, episodes):
-            if should_stop is not None and should_stop():
-                interrupted = True
-                break
-            t0, physics0 = time.perf_counter(), world.physics_seconds
-            if setup.body.name in world.bodies:
-                world.remove_body(setup.body.name)
-            world.restore(state)
-            recorder = record(world) if (record is not None and setup.index == record_episode) else None
-            sm = _StateMachine(world, handle, tools, params, setup, recorder, log if setup.index == 0 else None)
-            if sink is not None:
-                sm.sink = sink.begin(world, handle, sm.obj, lambda sm=sm: sm.mover.phase)
-            try:
-                sm.run()
-                failed, reason = None, "placed"
-            except MoveFailed as exc:
-                failed, reason = exc.phase, exc.reason
-                sm.close_phase(False, reason)
-            if recorder is not None:
-                if hasattr(recorder, "finish"):  # record= may be any object with save()
-                    recorder.finish(failed is None, "" if failed is None else f"{failed}: {reason}")
-                recorder.save()
-            res = sm.result(failed, reason)
-            if sm.sink is not None:
-                sink.end(sm.sink, setup.index, setup.seed, res.success, res.failed_phase, res.reason)
-            timing.per_episode.append(time.perf_counter() - t0)
-            timing.physics_per_episode.append(world.physics_seconds - physics0)
-            results.append(res)
-            if on_episode:
-                on_episode(res)
-    timing.wall_time = time.perf_counter() - t_all
-    report = PickPlaceReport(task=str(task.path), robot=robot.config.name, arm=arm_cfg.name, seed=seed,
-                             summary=summarise(results), episodes=results,
-                             warnings=[w.format() for w in task.warnings] + _reactive_warnings(tools.reactive),
-                             interrupted=interrupted)
-    return report, timing
-
-
-def _reactive_warnings(drive) -> list[str]:
-    return [f"obstacle {name!r} is a mesh: the reactive controller does not avoid it"
-            for name in (drive.skipped if drive is not None else [])]
+def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[EpisodeSetup]:
+    """The setups of episodes 0 .. ``episodes`` − 1."""
+    return [episode_setup(params, seed, k) for k in range(episodes)]
 
 
 @dataclass(frozen=True)
-class _Tools:
-    """Per-run helpers shared by every episode: kinematic model, scaled joint limits and, with
-    ``motion: reactive``, the follow-target controller driving the free-space moves."""
+class PickPlaceOptions:
+    """``run pick-place``'s own options: recording a dataset (the CLI builds the sink from them)."""
 
-    model: object
-    limits: object
-    reactive: object | None = None
-
-
-def _reactive_drive(robot, world, arm_name: str, params: PickPlaceParams):
-    """The controller for ``motion: reactive`` (built once per run: it is expensive), else None."""
-    if params.motion != "reactive":
-        return None
-    from robocfg.motion.reactive_drive import bounding_radius, build_reactive_drive
-
-    obj = params.object  # held object's centre beyond the TCP, along the tool axis (m)
-    beyond = obj.half_height() - SUCTION_PRESS if world.robot.arm(arm_name).gripper.grasps_at_surface else params.grasp_depth
-    return build_reactive_drive(robot, world, arm_name, velocity_scale=params.speed_scale,
-                                payload=(beyond, bounding_radius(obj)))
+    dataset: Path | None = field(default=None, metadata=option(
+        "--dataset", help="Record the episodes into this new directory (see --dataset-format)."))
+    dataset_format: str = field(default="lerobot", metadata=option(
+        "--dataset-format", choices=("lerobot", "hdf5"),
+        help="lerobot (LeRobot v3.0: parquet + MP4) or hdf5 (robomimic layout)."))
+    dataset_fps: int = field(default=20, metadata=option(
+        "--dataset-fps", minimum=1, help="Frames per second of simulated time (must divide the physics rate)."))
+    keep: str = field(default="success", metadata=option(
+        "--keep", choices=("success", "all"), help="success: write successful episodes only; all: failures too, labelled."))
 
 
-class _StateMachine:
-    def __init__(self, world, arm, tools: _Tools, params: PickPlaceParams, setup: EpisodeSetup, recorder,
-                 log: Log | None):
-        self.world, self.params, self.setup, self.recorder = world, params, setup, recorder
-        self.log = log or (lambda _msg: None)
-        self.arm, self.cfg, self.gripper = arm, arm.config, arm.gripper
-        self.model = tools.model
-        self.reactive = tools.reactive
-        self.mover = ArmMover(world, arm, tools.model, tools.limits, params.position_tolerance,
-                              params.orientation_tolerance, on_step=self._on_step, phase="setup")
-        if params.grip_force is not None and hasattr(self.gripper, "set_force"):
-            self.gripper.set_force(params.grip_force)
-        self.obj = world.add_body(setup.body)
-        self.phases: list[PhaseRecord] = []
-        self._phase: tuple[str, float] | None = None
-        self.lift_rise: float | None = None
-        self.sink = None  # a dataset EpisodeRecorder: sees every physics step
+class PickPlaceSession(EpisodeSession[EpisodeResult]):
+    """The pick-place world, kinematic model and limits, shared by every episode."""
 
-    # ---- phases ------------------------------------------------------------------------------
-    def run(self) -> None:
-        p = self.params
-        self.gripper.open()
-        self.mover.settle(0.2)
-        obj_pos, _ = self.world.body_pose(self.obj)
-        self.support_z = obj_pos[2] - self.setup.body.half_height()
-        if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
-            center = obj_pos + np.array([0, 0, self.setup.body.half_height() - SUCTION_PRESS])
-        else:
-            center = obj_pos + np.array([0, 0, p.grasp_depth])
-        grasp = self._choose_grasp(center)
-        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
-        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
+    def prepare(self) -> None:
+        from robocfg.kinematics.model import KinematicModel
+        from robocfg.motion.limits import limits_from_robot
 
-        self.begin("pre_grasp", "move above the object")
-        self._free_move(T_pre)
-        self.begin("approach", "down to grasp height")
-        self.mover.move(T_grasp, straight=True)
-        self.begin("grasp", "close the gripper")
-        self.mover.close_until_held(self.obj, self.mover.timeout)
-        self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
-        z0 = self.world.body_pose(self.obj)[0][2]
-        T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
-        self.mover.move(T_lift, straight=True)
-        self._verify_lift(z0)
-        # Carry the object so that *it* lands on the place point: keep its offset from the EE.
-        obj_now = self.world.body_pose(self.obj)[0]
-        ee_now = self.arm.ee_pose()[:3, 3]
-        offset = ee_now - obj_now
-        place_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height() + RELEASE_CLEARANCE
-        place_obj = np.array([*self.setup.place_xy, place_z])
-        T_place = T_lift.copy()
-        T_place[:3, 3] = place_obj + offset
-        T_above_place = T_place.copy()
-        T_above_place[2, 3] = max(T_lift[2, 3], T_place[2, 3] + p.lift_height)
-        self.begin("transport", "carry above the place point")
-        self._free_move(T_above_place, check=self._dropped)
-        self.begin("lower", "lower onto the support")
-        self.mover.move(T_place, straight=True, check=self._dropped)
-        self.begin("release", "open the gripper")
-        self._release()
-        self.begin("retract", "move up and away")
-        self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
-        self.close_phase(True)
-        self.mover.settle(0.3)
-        self._check_placed()
+        self.params: PickPlaceParams = self.task.config.pick_place  # type: ignore[union-attr]
+        robot = self.task.robots[0]
+        self.arm_cfg = robot.config.arm(self.options.arm)
+        self.handle = self.world.robot.arm(self.arm_cfg.name)
+        model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
+        bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
+        scale = self.params.speed_scale
+        self.tools = _Tools(model, limits_from_robot(robot, self.handle.joints,
+                                                     Limits(velocity_scale=scale, acceleration_scale=scale)),
+                            reactive_drive(robot, self.world, self.arm_cfg.name, self.params))
 
-    def begin(self, name: str, what: str) -> None:
-        if self._phase is not None:
-            self.close_phase(True)
-        self._phase = (name, self.world.t)
-        self.mover.phase, self.mover.timeout = name, getattr(self.params.timeouts, name)
-        if hasattr(self.recorder, "set_phase"):
-            self.recorder.set_phase(name)
-        n = len(self.phases) + 1
-        self.log(f"Phase {n}: {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
+    def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
+        setup = episode_setup(self.params, self.seed, k)
+        self.remove_after_episode(setup.body.name)  # the state machine spawns it
+        sm = _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k))
+        sink = self.options.sink
+        if sink is not None:
+            sm.sink = sink.begin(self.world, self.handle, sm.obj, lambda: sm.mover.phase)
+        try:
+            sm.run()
+            failed, reason = None, "placed"
+        except MoveFailed as exc:
+            failed, reason = exc.phase, exc.reason
+            sm.close_phase(False, reason)
+        if recorder is not None:
+            recorder.finish(failed is None, "" if failed is None else f"{failed}: {reason}")
+        res = sm.result(failed, reason)
+        if sm.sink is not None:
+            sink.end(sm.sink, setup.index, setup.seed, res.success, res.failed_phase, res.reason)
+        return res
 
-    def close_phase(self, ok: bool, detail: str = "") -> None:
-        if self._phase is None:
-            return
-        name, t0 = self._phase
-        self.phases.append(PhaseRecord(name, round(t0, 6), round(self.world.t, 6), ok, detail))
-        self._phase = None
-
-    # ---- motion ------------------------------------------------------------------------------
-    def _free_move(self, T: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
-        """A free-space move (pre-grasp, transport): joint-space trajectory or reactive controller."""
-        if self.reactive is None:
-            self.mover.move(T, straight=False, check=check)
-        else:
-            self.mover.move_reactive(T, self.reactive, check=check)
-
-    def _choose_grasp(self, center: np.ndarray) -> Grasp:
-        """Of the two top-down grasps, the one needing the least joint travel (largest |Δq|, rad)
-        to reach the pre-grasp pose and from there the pose above the place point; the smaller
-        wrist turn breaks ties. (IK can land on a far branch for one of the two, e.g. a Panda's
-        shoulder flipped by ≈ 3 rad, or a wrist that must wind round a joint limit to carry.)"""
-        b = self.setup.body
-        extent = (b.size[0], b.size[1]) if b.shape in ("box", "mesh") else (2 * b.size[0], 2 * b.size[0])
-        R_now = self.arm.ee_pose()[:3, :3]
-        cands = sorted(top_down_grasps(center, self.setup.yaw, extent),
-                       key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
-        q0 = self.arm.joint_positions()
-        shift = np.array([*(self.setup.place_xy - center[:2]), 0.0])
-
-        def travel(g: Grasp) -> float:
-            T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
-            cost, q = 0.0, q0
-            for T in (T_pre, _shifted(T_pre, shift)):
-                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
-                if not res.converged:
-                    return math.inf
-                cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
-            return cost
-
-        costs = [travel(g) for g in cands]
-        return cands[int(np.argmin(costs))] if min(costs) < math.inf else cands[0]
-
-    def _release(self) -> None:
-        t0 = self.world.t
-        self.gripper.open()
-        opening = getattr(self.gripper, "fraction", None)
-        while self._held() or (opening is not None and opening() < 0.9):
-            if self.world.t - t0 > self.mover.timeout:
-                raise MoveFailed("release", "the object did not come free")
-            self.mover.step(SETTLE_POLL)
-
-    def _dropped(self) -> str | None:
-        if self._held():
-            return None
-        return f"object dropped ({self._object_to_tcp() * 100:.1f} cm from the TCP)"
-
-    def _held(self) -> bool:
-        return bool(self.gripper.is_grasping(self.obj))
-
-    def _object_to_tcp(self) -> float:
-        return float(np.linalg.norm(self.world.body_pose(self.obj)[0] - self.arm.tcp_pose()[:3, 3]))
-
-    def _verify_lift(self, z0: float) -> None:
-        z1 = self.world.body_pose(self.obj)[0][2]
-        self.lift_rise = float(z1 - z0)
-        want = 0.5 * self.params.lift_height
-        if not self._held() or self.lift_rise < want:
-            below = self.arm.tcp_pose()[2, 3] - z1
-            raise MoveFailed("lift", f"object slipped, {below * 100:.1f} cm below the fingers (rose {self.lift_rise * 100:.1f} cm)")
-
-    # ---- world helpers -----------------------------------------------------------------------
-    def _on_step(self) -> None:
-        if self.sink is not None:
-            self.sink.on_step()
-        if self.recorder is not None:
-            self.recorder.maybe_capture()
-
-    def _support_height(self, xy: np.ndarray) -> float:
-        """Height (m) of the first surface below ``xy`` that is not the robot or the object."""
-        import pybullet as pb
-
-        c = self.world.client
-        skip = {self.obj, *(r.body_id for r in self.world.robots)}
-        results = pb.rayTestBatch([[xy[0], xy[1], 5.0]], [[xy[0], xy[1], -1.0]], reportHitNumber=-1,
-                                  physicsClientId=c)
-        z = 0.0 if self.world.task.config.scene.ground else -math.inf
-        for hit in results:
-            if hit[0] >= 0 and hit[0] not in skip:
-                z = max(z, hit[3][2])
-        return z if math.isfinite(z) else self.support_z
-
-    def _check_placed(self) -> None:
-        p = self.params
-        pos, quat = self.world.body_pose(self.obj)
-        err = float(np.linalg.norm(pos[:2] - self.setup.place_xy))
-        tilt = self._tilt(quat)
-        rest_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height()
-        if err > p.success_tolerance:
-            raise MoveFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
-        if tilt > p.max_tilt_deg:
-            raise MoveFailed("place", f"object tilted {tilt:.1f}° (max {p.max_tilt_deg:.0f}°)")
-        if abs(pos[2] - rest_z) > 0.01:
-            raise MoveFailed("place", f"object not resting on the support (centre {pos[2] * 100:.1f} cm, expected {rest_z * 100:.1f} cm)")
-
-    @staticmethod
-    def _tilt(quat) -> float:
-        from robocfg.geometry import quat_to_matrix
-
-        z = quat_to_matrix(quat)[:, 2]
-        return math.degrees(math.acos(max(-1.0, min(1.0, float(z[2])))))
-
-    def result(self, failed: str | None, reason: str) -> EpisodeResult:
-        pos, quat = self.world.body_pose(self.obj)
-        b, s = self.setup.body, self.setup
-        err = float(np.linalg.norm(pos[:2] - s.place_xy))
-        return EpisodeResult(
-            index=s.index, seed=s.seed, success=failed is None, failed_phase=failed, reason=reason,
-            object_start=[round(float(v), 6) for v in b.position],
-            object_start_yaw_deg=round(math.degrees(s.yaw), 4),
-            place_target=[round(float(v), 6) for v in s.place_xy],
-            object_final=[round(float(v), 6) for v in pos],
-            place_error=round(err, 6), tilt_deg=round(self._tilt(quat), 4),
-            lift_rise=None if self.lift_rise is None else round(self.lift_rise, 6),
-            mass=round(b.mass, 6), friction=round(b.friction, 6),
-            sim_time=round(self.world.t, 6), steps=self.world.steps, phases=self.phases,
-        )
+    def report(self, records: list[EpisodeResult], interrupted: bool) -> PickPlaceReport:
+        skipped = self.tools.reactive.skipped if self.tools.reactive is not None else []
+        warnings = [w.format() for w in self.task.warnings]
+        warnings += [f"obstacle {name!r} is a mesh: the reactive controller does not avoid it" for name in skipped]
+        return PickPlaceReport(task=str(self.task.path), robot=self.task.robots[0].config.name,
+                               arm=self.arm_cfg.name, seed=self.seed, summary=summarise(records), episodes=records,
+                               warnings=warnings, interrupted=interrupted)
 
 
-def _shifted(T: np.ndarray, d) -> np.ndarray:
-    out = T.copy()
-    out[:3, 3] += np.asarray(d, float)
-    return out
+@register_task
+class PickPlaceRunner(EpisodicRunner):
+    kind = "pick_place"
+    params = PickPlaceParams
+    report = PickPlaceReport
+    Options = PickPlaceOptions
+    verb = "placed"
+    summary = "Pick the task's object and place it, robot-agnostic (grasp → EE by R_ee_graspnet, ee_axis, tcp_offset)."
+    description = (
+        "Exit 0 when the success rate reaches --min-success (default: every episode), 1 otherwise; the "
+        "--json report (one record per episode; no wall-clock figures, so the same seed gives the same "
+        "file) is written either way. With --dataset every episode is recorded at --dataset-fps "
+        "(observations, the joint-target + gripper actions that drove the robot, phase labels, images of "
+        "the task's cameras) and the kept ones are written as a LeRobot v3.0 or robomimic HDF5 dataset; "
+        "`robocfg dataset replay` re-simulates an episode from those actions.")
+
+    def open_session(self) -> PickPlaceSession:
+        return PickPlaceSession(self.task, self.options)
 
 
+def run_pick_place(task, episodes: int = 1, seed: int | None = None, arm: str | None = None,
+                   gui: bool = False, record: Callable[[Any], FrameRecorder] | None = None, record_episode: int = 0,
+                   log: Callable[[str], None] | None = None,
+                   on_episode: Callable[[EpisodeResult], None] | None = None,
+                   sink: Any = None, should_stop: Callable[[], bool] | None = None) -> tuple[PickPlaceReport, BatchTiming]:
+    """``episodes`` episodes of a pick-place task; (report, wall-clock timing). Keyword form of
+    ``PickPlaceRunner(task, RunOptions(...)).run()`` kept for scripts and benchmarks; ``record``
+    is a recorder factory ``world -> recorder`` for episode ``record_episode``."""
+    options = RunOptions(seed=seed, episodes=episodes, arm=arm, gui=gui, recorder=record, record_episode=record_episode,
+                         log=log, on_episode=on_episode, sink=sink, should_stop=should_stop)  # type: ignore[arg-type]
+    out = PickPlaceRunner(task, options).run()
+    return out.report, out.timing

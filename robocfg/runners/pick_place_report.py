@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from robocfg.engine.runner import EpisodesReport, ReportView
+from robocfg.engine.session import BatchTiming
 from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
 PHASES = ("pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
@@ -54,7 +56,7 @@ class PickPlaceSummary:
 
 
 @dataclass
-class PickPlaceReport:
+class PickPlaceReport(EpisodesReport):
     """The ``--json`` report. ``interrupted``: the run was stopped (SIGINT/SIGTERM) and
     ``episodes`` holds only the episodes that finished."""
 
@@ -68,23 +70,33 @@ class PickPlaceReport:
     warnings: list[str] = field(default_factory=list)
     interrupted: bool = False
 
+    def summary_line(self, timing: BatchTiming | None) -> str:
+        s = self.summary
+        ok = "ok" if s.successes == s.episodes else "failed"
+        return (f"{ok}: {self.robot} placed {s.successes}/{s.episodes} ({s.success_rate:.1%}), "
+                f"{s.mean_sim_time:.2f} s simulated per episode")
 
-@dataclass
-class PickPlaceTiming:
-    """Wall-clock figures (not part of the deterministic JSON)."""
+    def view(self, timing: BatchTiming | None) -> ReportView:
+        s = self.summary
+        failed = [e for e in self.episodes if not e.success]
+        rows = [("episodes", str(s.episodes)), ("success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%})"),
+                ("failures by phase", ", ".join(f"{k}: {v}" for k, v in s.failures_by_phase.items()) or "none"),
+                ("simulated time / episode", f"{s.mean_sim_time:.2f} s")]
+        if timing is not None:
+            rows.append(("wall time / episode", f"{timing.mean_episode:.3f} s (total {timing.wall_time:.1f} s)"))
+        if s.episodes == 1:
+            e = self.episodes[0]
+            rows += [("place error", f"{(e.place_error or 0.0) * 100:.2f} cm"), ("tilt", f"{e.tilt_deg or 0.0:.1f}°")]
+        footer = []
+        if failed:
+            footer.append(f"failed episodes: {', '.join(str(e.index) for e in failed[:20])}"
+                          f"{' ...' if len(failed) > 20 else ''} (seeds and details in --json)")
+        return ReportView(f"run pick-place: {self.robot} (arm {self.arm}), seed {self.seed}", rows,
+                          warnings=list(self.warnings), failures=self.failure_lines(), footer=footer,
+                          status="failed" if failed else "ok")
 
-    wall_time: float = 0.0
-    per_episode: list[float] = field(default_factory=list)
-    physics_per_episode: list[float] = field(default_factory=list)  # s inside p.stepSimulation
 
-    @property
-    def mean_physics(self) -> float:
-        n = len(self.physics_per_episode)
-        return sum(self.physics_per_episode) / n if n else 0.0
-
-    @property
-    def mean_episode(self) -> float:
-        return sum(self.per_episode) / len(self.per_episode) if self.per_episode else 0.0
+PickPlaceTiming = BatchTiming  # wall-clock figures, kept apart from the deterministic JSON
 
 
 def summarise(episodes: list[EpisodeResult]) -> PickPlaceSummary:

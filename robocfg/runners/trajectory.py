@@ -18,7 +18,10 @@ import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import TrajectoryParams
-from robocfg.errors import RunFailed
+from robocfg.engine.options import option
+from robocfg.engine.registry import register_task
+from robocfg.engine.runner import ReportView, RunOutput, TableView, TaskRunner
+from robocfg.errors import ConfigError, Problem, RunFailed, RunInterrupted
 from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
 
 CHECK_RATE = 1000.0  # Hz: resampling rate of the limit check
@@ -65,9 +68,104 @@ class TrajectoryResult:
     wall_time: float = 0.0
     record: str | None = None
     plot: str | None = None
+    interrupted: bool = False  # stopped by SIGINT/SIGTERM while following
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def passed(self, min_success: float) -> bool:
+        return self.success
+
+    def failure_lines(self) -> list[str]:
+        return []
+
+    def episodes_finished(self) -> int:
+        return 0 if self.interrupted else 1
+
+    def summary_line(self, timing: object = None) -> str:
+        tr = self.tracking
+        track = "" if tr is None else f", tracking RMS {tr['rms']:.2e} rad, final {tr['final']:.2e} rad"
+        status = "ok" if self.success else "FAILED"
+        return (f"{status}: {self.robot} {len(self.waypoints)} waypoints, {self.method}, duration {self.duration:.3f} s, "
+                f"planned in {self.planning_time_ms:.1f} ms, {self.limit_check['total']} limit violations at 1 kHz{track}")
+
+    def view(self, timing: object = None) -> ReportView:
+        lc = self.limit_check
+        rows = [
+            ("method", f"{self.method} ({self.path} path" + (f", {self.gridpoints} gridpoints" if self.gridpoints else "") + ")"),
+            ("stop at waypoints", str(self.stop_at_waypoints)),
+            ("duration", f"{self.duration:.3f} s"),
+            ("planning time", f"{self.planning_time_ms:.1f} ms"),
+            ("limit violations (1 kHz)", f"{lc['total']} (peak |q̇|/limit {lc['peak_velocity_ratio']:.4f}, "
+                                         f"|q̈|/limit {lc['peak_acceleration_ratio']:.4f})"),
+        ]
+        t = self.tracking
+        if t is not None:
+            rows += [("tracking RMS / max", f"{t['rms']:.2e} / {t['max']:.2e} rad (worst joint)"),
+                     ("final error", f"{t['final']:.2e} rad at the end, {t['settled']:.2e} rad after {t['settle_time']:.2f} s"),
+                     ("simulated / wall time", f"{self.sim_time:.2f} s / {self.wall_time:.2f} s")]
+        rows += [(k, v) for k, v in (("plot", self.plot), ("record", self.record)) if v]
+        tables = [TableView("waypoints", ["#", "from", "t (s)", *self.joint_names],
+                            [[str(i), self.waypoint_kinds[k], f"{tw:.3f}", *(f"{v:+.3f}" for v in q)]
+                             for k, (i, q, tw) in enumerate(zip(self.waypoint_indices, self.waypoints,
+                                                                self.waypoint_times, strict=True))])]
+        if t is not None:
+            lim = self.limits
+            tables.append(TableView("tracking error per joint (rad)", ["joint", "v max", "a max", "RMS", "max", "final"],
+                                    [[n, f"{lim['velocity'][k]:.3f}", f"{lim['acceleration'][k]:.2f}",
+                                      f"{t['rms_per_joint'][k]:.2e}", f"{t['max_per_joint'][k]:.2e}",
+                                      f"{t['final_per_joint'][k]:.2e}"] for k, n in enumerate(self.joint_names)]))
+        return ReportView(f"run trajectory: {self.robot} ({self.arm})", rows, tables=tables, warnings=list(self.warnings),
+                          notes=list(self.notes), status="ok" if self.success else "failed",
+                          status_text="" if self.success else "limit violations")
+
+
+@dataclass(frozen=True)
+class TrajectoryOptions:
+    """``run trajectory``'s own options."""
+
+    plot: Path | None = field(default=None, metadata=option(
+        "--plot", output=(".png",), help="Write a PNG of q, q̇, q̈ per joint against time (limits dashed)."))
+    no_sim: bool = field(default=False, metadata=option("--no-sim", help="Plan and check only; do not simulate."))
+
+
+@register_task
+class TrajectoryRunner(TaskRunner):
+    kind = "trajectory"
+    params = TrajectoryParams
+    report = TrajectoryResult
+    Options = TrajectoryOptions
+    summary = ("Plan a time-optimal trajectory through the task's waypoints (toppra; trapezoids with "
+               "stop_at_waypoints; ruckig with a jerk limit), check it against the limits at 1 kHz, and track it "
+               "in PyBullet. Prints duration, planning time, violations and tracking error.")
+
+    def check(self) -> None:
+        super().check()
+        x = self.options.extras
+        if isinstance(x, TrajectoryOptions) and x.no_sim and self.options.record is not None:
+            raise ConfigError([Problem("--record", None, None, "", "--record needs the simulation (drop --no-sim)")])
+
+    def run(self) -> RunOutput:
+        o, x = self.options, self.options.extras
+        no_sim = isinstance(x, TrajectoryOptions) and x.no_sim
+        result = run_trajectory(self.task, gui=o.gui, record=o.record, follow=not no_sim, arm=o.arm,
+                                should_stop=o.should_stop)
+        if isinstance(x, TrajectoryOptions) and x.plot is not None:
+            plot_result(result, x.plot)
+        return RunOutput(result)
+
+
+def plot_result(r: TrajectoryResult, path: Path) -> None:
+    """q, q̇, q̈ per joint against time into ``path`` (PNG); the measured q too when followed."""
+    from robocfg.motion.plot import plot_trajectory
+
+    s = r.samples
+    assert s is not None
+    measured = (r.measured["t"], r.measured["q"]) if r.measured else None
+    title = (f"{r.robot}: {r.method} ({r.path} path), duration {r.duration:.3f} s — "
+             "limits dashed, waypoints dotted")
+    r.plot = str(plot_trajectory(path, s.t, s.q, s.qd, s.qdd, r.joint_names, r.limits, r.waypoint_times,
+                                 measured, title))
 
 
 def _rounded(a: np.ndarray) -> list:
@@ -75,16 +173,17 @@ def _rounded(a: np.ndarray) -> list:
     return np.round(np.asarray(a, dtype=float), 9).tolist()
 
 
-def plan_task(task: CheckedTask):
-    """Resolve the task's waypoints and plan. Returns (params, arm config, joint names, limits,
-    Waypoints, Plan). Raises ConfigError (bad waypoints/limits) or RunFailed (unreachable pose)."""
+def plan_task(task: CheckedTask, arm_name: str | None = None):
+    """Resolve the task's waypoints and plan (``arm_name`` overrides the task's ``arm``). Returns
+    (params, arm config, joint names, limits, Waypoints, Plan). Raises ConfigError (bad
+    waypoints/limits) or RunFailed (unreachable pose)."""
     from robocfg.motion.limits import limits_from_robot
     from robocfg.motion.plan import plan_trajectory
     from robocfg.motion.waypoints import resolve_waypoints
 
     params: TrajectoryParams = task.config.trajectory  # type: ignore[union-attr]
     robot = task.robots[0]
-    arm = robot.config.arm(params.arm)
+    arm = robot.config.arm(arm_name or params.arm)
     names = robot.arm_joints(arm)
     limits = limits_from_robot(robot, names, params.limits)
     home = np.asarray(arm.home, dtype=float)
@@ -111,17 +210,19 @@ def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
 
 
 def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = None,
-                   follow: bool = True, fps: float = 15.0) -> TrajectoryResult:
+                   follow: bool = True, fps: float = 15.0, arm: str | None = None,
+                   should_stop=None) -> TrajectoryResult:
     """Plan and (if ``follow``) track the task's trajectory. Raises ConfigError for bad input,
-    RunFailed (with the result so far) if a phase fails."""
+    RunFailed (with the result so far) if a phase fails; ``should_stop`` (SIGINT) ends the
+    following early with the result marked ``interrupted``."""
     from robocfg.motion.trajectory import check_limits
 
     t_wall = time.perf_counter()
-    params, arm, names, limits, wps, plan = plan_task(task)
+    params, arm_cfg, names, limits, wps, plan = plan_task(task, arm)
     check = check_limits(plan.trajectory, limits, CHECK_RATE)
     s = plan.trajectory.sample(params.sample_rate)
     result = TrajectoryResult(
-        task=str(task.path), robot=task.robots[0].config.name, arm=arm.name, joint_names=list(names),
+        task=str(task.path), robot=task.robots[0].config.name, arm=arm_cfg.name, joint_names=list(names),
         method=plan.method, path=plan.path, stop_at_waypoints=params.stop_at_waypoints,
         duration=plan.duration, planning_time_ms=plan.planning_time * 1e3, gridpoints=plan.gridpoints,
         fit_factor=plan.fit_factor, waypoints=plan.waypoints.tolist(), waypoint_indices=list(plan.waypoint_indices),
@@ -140,17 +241,18 @@ def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = N
         result.success = check.total == 0
         result.wall_time = time.perf_counter() - t_wall
         return result
-    _follow(task, params, names, plan, result, gui, record, fps)
+    _follow(task, params, names, plan, result, gui, record, fps, should_stop)
     result.wall_time = time.perf_counter() - t_wall
     return result
 
 
-def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps) -> None:
+def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps, should_stop) -> None:
     from robocfg.motion.follower import follow
     from robocfg.sim.record import CameraView, Recorder
     from robocfg.sim.world import World
 
     with World(task, gui=gui) as world:
+        world.should_stop = should_stop
         result.warnings += list(world.warnings)
         robot = world.robot
         robot.reset_joints(names, plan.waypoints[0])
@@ -164,6 +266,9 @@ def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fp
         try:
             tr = follow(world, names, plan.trajectory, params.settle_time,
                         on_step=recorder.maybe_capture if recorder is not None else None)
+        except RunInterrupted:
+            result.interrupted = True
+            return
         except RunFailed as exc:
             raise RunFailed(exc.phase, exc.reason, report=result) from None
         finally:

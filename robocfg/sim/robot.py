@@ -276,6 +276,14 @@ class ArmHandle:
     def joint_positions(self) -> np.ndarray:
         return self.robot.joint_positions(self.joints)
 
+    def require_gripper(self) -> Gripper:
+        """The arm's gripper; ``RobocfgError`` naming the arm when it has none."""
+        if self.gripper is None:
+            from robocfg.errors import RobocfgError
+
+            raise RobocfgError(f"arm {self.config.name!r} of robot {self.robot.name!r} has no gripper")
+        return self.gripper
+
     def command(self, q: Sequence[float] | np.ndarray, velocities: Sequence[float] | np.ndarray | None = None) -> None:
         """Drive the arm joints to ``q`` (rad) with the robot YAML's arm gains."""
         self.robot.command_positions(self.joints, q, velocities)

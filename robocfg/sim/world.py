@@ -20,6 +20,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -30,12 +31,13 @@ from robocfg.checks.task import CheckedTask
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
 from robocfg.config.task import RobotMount
-from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError
+from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
 from robocfg.sim.bodies import spawn_body, spawn_ground, spawn_pedestal, spawn_table
 from robocfg.sim.gripper import make_gripper
 from robocfg.sim.loading import load_robot_urdf
 from robocfg.sim.mimic import MimicGears
+from robocfg.sim.queries import SceneQueries
 from robocfg.sim.robot import RobotHandle
 
 MAX_JOINT_VELOCITY = 100.0  # rad/s or m/s: beyond this the physics is taken as diverged
@@ -44,8 +46,9 @@ CHECK_INTERVAL = 0.02  # s of simulated time between divergence checks (one chec
 SPAWN_OVERLAP_WARN = 0.002  # m: penetration between a spawned body and a robot that earns a warning
 
 
-class World:
-    """Physics client + scene + robots. See the module docstring for the interface."""
+class World(SceneQueries):
+    """Physics client + scene + robots. See the module docstring for the interface; the physics
+    queries (ray casts, contacts, closest points, AABBs, dynamics) come from ``SceneQueries``."""
 
     def __init__(self, task: CheckedTask, gui: bool = False, max_joint_velocity: float = MAX_JOINT_VELOCITY,
                  max_body_speed: float = MAX_BODY_SPEED, check_interval: float = CHECK_INTERVAL):
@@ -58,6 +61,8 @@ class World:
         self.physics_seconds = 0.0  # wall-clock time spent inside p.stepSimulation (for benchmarks)
         self.max_joint_velocity, self.max_body_speed = max_joint_velocity, max_body_speed
         self._check_every = max(1, round(check_interval / self.dt))
+        # Asked every check interval; True ends the run with RunInterrupted (SIGINT during a one-episode run).
+        self.should_stop: Callable[[], bool] | None = None
         self.warnings: list[str] = []
         self.bodies: dict[str, int] = {}
         self.robots: list[RobotHandle] = []
@@ -251,6 +256,8 @@ class World:
                 g.update()
             if self.steps % self._check_every == 0:
                 self._check()
+                if self.should_stop is not None and self.should_stop():
+                    raise RunInterrupted("simulation", "SIGINT/SIGTERM")
 
     def snapshot(self) -> int:
         """Save the physics state (bodies, joints, contacts) to come back to with ``restore``.

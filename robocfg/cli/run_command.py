@@ -1,0 +1,180 @@
+"""One command factory for every ``robocfg run <kind>``: the same options, help, progress bar,
+output-path checks, exit codes, SIGINT partial report and printing for every registered kind.
+
+The options every kind gets: ``TASK``, ``--robot/-r``, ``--arm``, ``--seed``, ``-n/--episodes``,
+``--json``, ``--record``, ``--record-episode``, ``--gui``, ``-q``, ``--min-success``. A kind's own
+options are the fields of its ``Options`` dataclass (``robocfg.engine.option``). Front-end
+additions that need the CLI's own imports (the dataset sink of pick-place) are :class:`CliHook` s.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, SeedOpt, _output_path
+
+if TYPE_CHECKING:
+    from robocfg.checks.task import CheckedTask
+    from robocfg.engine.options import RunOptions
+    from robocfg.engine.runner import TaskRunner
+
+
+@dataclass
+class CliHook:
+    """Front-end work around a kind's run: ``prepare`` may add to the options before the run
+    (e.g. a dataset sink), ``finish`` runs after it with the report and returns lines to print."""
+
+    prepare: Callable[[CheckedTask, RunOptions, str | None], RunOptions]
+    finish: Callable[[RunOptions, Any], list[str]]
+
+
+HOOKS: dict[str, CliHook] = {}
+
+
+def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Parameter]:
+    def opt(name: str, annotation: Any, default: Any) -> inspect.Parameter:
+        return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation, default=default)
+
+    return [
+        opt("task", Annotated[str, typer.Argument(help=f"Task name or YAML path (a 'task: {kind}' file).")], kind),
+        opt("robot", RobotOpt, None),
+        opt("arm", Annotated[str | None, typer.Option("--arm", help="Arm to use on a multi-arm robot (default: the first).")], None),
+        opt("seed", SeedOpt, None),
+        opt("episodes", Annotated[int, typer.Option("--episodes", "-n", min=1,
+                                                    help="Number of seeded episodes (episode k: rng([seed, k])).")], 1),
+        opt("json_path", JsonOpt, None),
+        opt("record", RecordOpt, None),
+        opt("record_episode", Annotated[int, typer.Option("--record-episode", min=0, help="Which episode --record films.")], 0),
+        opt("gui", GuiOpt, False),
+        opt("quiet", QuietOpt, False),
+        opt("min_success", Annotated[float, typer.Option("--min-success", min=0.0, max=1.0,
+                                                         help=f"Exit 1 when the share of episodes {verb} is below this.")], 1.0),
+    ]
+
+
+def _kind_parameters(options_type: type | None) -> list[inspect.Parameter]:
+    from robocfg.engine.options import option_spec
+
+    if options_type is None:
+        return []
+    out = []
+    for f in dataclasses.fields(options_type):
+        spec = option_spec(f)
+        kw: dict[str, Any] = {"help": spec.help}
+        if spec.output_suffixes:
+            suffixes, flag = spec.output_suffixes, spec.flags[0]
+            kw.update(parser=_output(suffixes, flag), metavar="PATH")
+        if spec.minimum is not None:
+            kw.update(min=spec.minimum)
+        if spec.choices:
+            choices, flag = spec.choices, spec.flags[0]
+            kw.update(callback=_choice(choices, flag))
+        hint = _resolve(options_type, f.name)
+        annotation = Annotated[hint, typer.Option(*spec.flags, **kw)]  # type: ignore[valid-type]
+        out.append(inspect.Parameter(f"x_{f.name}", inspect.Parameter.KEYWORD_ONLY, annotation=annotation,
+                                     default=f.default))
+    return out
+
+
+def _output(suffixes: tuple[str, ...], option: str) -> Callable[[str], Path]:
+    def parse(raw: str) -> Path:
+        return _output_path(raw, option, suffixes)
+
+    return parse
+
+
+def _resolve(cls: type, name: str) -> Any:
+    """The type of field ``name`` (annotations may be strings under postponed evaluation)."""
+    import typing
+
+    return typing.get_type_hints(cls)[name]
+
+
+def _choice(choices: tuple[str, ...], option: str) -> Callable[[str], str]:
+    def check(value: str) -> str:
+        if value not in choices:
+            raise typer.BadParameter(f"{value!r}: choose {' or '.join(choices)}", param_hint=option)
+        return value
+
+    return check
+
+
+def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
+    """The typer command function of a registered kind."""
+    from robocfg.engine.registry import command_name
+
+    command = command_name(runner.kind)
+    params = _common_parameters(runner.kind, command, runner.verb) + _kind_parameters(runner.Options)
+
+    def run_kind(**kw: Any) -> int:
+        extras = None
+        if runner.Options is not None:
+            extras = runner.Options(**{k[2:]: kw.pop(k) for k in list(kw) if k.startswith("x_")})
+        return execute(runner, extras=extras, **kw)
+
+    run_kind.__signature__ = inspect.Signature(params, return_annotation=int)  # type: ignore[attr-defined]
+    run_kind.__annotations__ = {p.name: p.annotation for p in params} | {"return": int}
+    run_kind.__doc__ = f"{runner.summary}\n\n{runner.description}" if runner.description else runner.summary
+    run_kind.__name__ = f"run_{runner.kind}"
+    return run_kind
+
+
+def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm: str | None, seed: int | None,
+            episodes: int, json_path: Path | None, record: Path | None, record_episode: int, gui: bool,
+            quiet: bool, min_success: float, extras: Any) -> int:
+    """Check, run, write and print one ``run <kind>``; the exit code (0, 1 or 130)."""
+    from robocfg.cli.common import console, load_task_for, write_json
+    from robocfg.cli.episodes import (
+        check_record_episode,
+        interrupted_line,
+        progress_bar,
+        stop_on_signals,
+    )
+    from robocfg.cli.run_print import print_report
+    from robocfg.engine.options import RunOptions
+    from robocfg.engine.registry import command_name
+    from robocfg.engine.runner import RunOutput
+    from robocfg.errors import RunFailed
+    from robocfg.sim.quiet import quiet_import
+
+    kind = runner_type.kind
+    check_record_episode(record_episode, episodes, record is not None)
+    quiet_import()
+    checked = load_task_for(task, kind, command_name(kind), robot)
+    out = console()
+    log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
+    options = RunOptions(seed=seed, episodes=episodes, arm=arm, gui=gui, record=record, record_episode=record_episode,
+                         extras=extras, log=log)
+    runner = runner_type(checked, options)
+    runner.check()  # exit 2 before anything is simulated
+    hook = HOOKS.get(kind)
+    if hook is not None:
+        runner.options = hook.prepare(checked, runner.options, robot)
+    failed: RunFailed | None = None
+    with stop_on_signals() as stop, \
+            progress_bar(command_name(kind), episodes, runner_type.verb, episodes > 1 and not quiet) as tick:
+        runner.options = dataclasses.replace(runner.options, on_episode=tick, should_stop=stop)
+        try:
+            output = runner.run()
+        except RunFailed as exc:
+            if exc.report is None:
+                raise
+            failed, output = exc, RunOutput(exc.report)
+    extra_lines = hook.finish(runner.options, output.report) if hook is not None else []
+    write_json(json_path, output.report)
+    print_report(output.report, output.timing, quiet, record, extra_lines)
+    if output.report.interrupted:
+        console(stderr=True).print(interrupted_line(stop, output.report.episodes_finished(), episodes, json_path),
+                                   markup=False)
+        return 130
+    if failed is not None:
+        return 1
+    return 0 if output.report.passed(min_success) else 1
+

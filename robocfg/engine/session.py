@@ -1,0 +1,208 @@
+"""Episodes: a world built once per process, restored before every episode, run by index.
+
+An :class:`EpisodeSession` owns one :class:`~robocfg.sim.world.World` built from a checked task
+and run options. Building it steps the world once, lets the kind prepare what every episode
+shares (``prepare``: measure the gripper, build the IK model...) and takes a snapshot. ``run(k)``
+then removes what the previous episode spawned, restores the snapshot (clock at zero, arms held,
+grippers open), attaches the recorder when ``k`` is the filmed episode, and calls the kind's
+``episode(k)`` — which draws its randomness from ``rng(k) = default_rng([seed, k])`` — so episode k
+gives the same record whichever episodes ran before it, in this process or another.
+
+A batch run is :func:`run_batch`: ``session.run(k)`` for k = 0, 1, ... until done or asked to
+stop. Executors split that loop; ``robocfg.engine.run_episode(spec)`` runs one index anywhere.
+"""
+
+from __future__ import annotations
+
+import time
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
+
+import numpy as np
+
+from robocfg.engine.options import EpisodeOutcome, FrameRecorder, RunOptions
+from robocfg.engine.runner import RunOutput, TaskRunner
+
+if TYPE_CHECKING:
+    from robocfg.checks.task import CheckedTask
+    from robocfg.config.scene import Body
+    from robocfg.sim.world import World
+
+RecordT = TypeVar("RecordT", bound=EpisodeOutcome)
+
+
+@dataclass
+class BatchTiming:
+    """Wall-clock figures of a batch (s); never part of the deterministic JSON report."""
+
+    wall_time: float = 0.0
+    per_episode: list[float] = field(default_factory=list)
+    physics_per_episode: list[float] = field(default_factory=list)  # s inside the physics engine's step
+
+    @property
+    def mean_physics(self) -> float:
+        n = len(self.physics_per_episode)
+        return sum(self.physics_per_episode) / n if n else 0.0
+
+    @property
+    def mean_episode(self) -> float:
+        return sum(self.per_episode) / len(self.per_episode) if self.per_episode else 0.0
+
+
+def episode_rng(seed: int, k: int) -> np.random.Generator:
+    """The random stream of episode ``k`` of a run seeded ``seed`` (the same wherever it runs)."""
+    return np.random.default_rng([seed, k])
+
+
+class Session(Protocol):
+    """What executors call: ``run(k)`` → episode k's record; ``close()`` frees the world."""
+
+    def run(self, k: int) -> Any: ...
+
+    def close(self) -> None: ...
+
+
+class EpisodeSession(ABC, Generic[RecordT]):
+    """One world and everything episodes share; ``run(k)`` gives episode k's record."""
+
+    def __init__(self, task: CheckedTask, options: RunOptions, timing: BatchTiming | None = None):
+        from robocfg.sim.world import World
+
+        self.task, self.options = task, options
+        self.seed = options.resolved_seed(task.config.sim.seed)
+        self.timing = timing if timing is not None else BatchTiming()
+        self._spawned: list[str] = []
+        self.world: World = World(task, gui=options.gui)
+        try:
+            self.world.step(1)
+            self.prepare()
+            self._state = self.world.snapshot()
+        except BaseException:
+            self.world.close()
+            raise
+
+    # ---- what a kind provides --------------------------------------------------------------
+    def prepare(self) -> None:
+        """Set up what every episode shares, before the snapshot (default: nothing)."""
+
+    @abstractmethod
+    def episode(self, k: int, recorder: FrameRecorder | None) -> RecordT:
+        """Run episode ``k`` in the freshly restored world; return its record. A phase that fails
+        ends the episode as a failed record (not an exception)."""
+
+    @abstractmethod
+    def report(self, records: list[RecordT], interrupted: bool) -> Any:
+        """The run's report from the records of the episodes that finished."""
+
+    def make_recorder(self, path: Any) -> FrameRecorder:
+        """The picture recorder for ``--record PATH`` (default: the fitted scene camera)."""
+        from robocfg.sim.record import Recorder
+
+        return Recorder(self.world, path, fps=12.0)
+
+    # ---- the engine ------------------------------------------------------------------------
+    def rng(self, k: int) -> np.random.Generator:
+        return episode_rng(self.seed, k)
+
+    def log_for(self, k: int) -> Callable[[str], None]:
+        log = self.options.log if k == 0 else None
+        return log or (lambda _msg: None)
+
+    def spawn(self, body: Body, static: bool = False) -> int:
+        """Add a body for this episode only (removed before the next episode's restore)."""
+        self.remove_after_episode(body.name)
+        return self.world.add_body(body, static=static)
+
+    def remove_after_episode(self, name: str) -> None:
+        """Remove body ``name`` (spawned by this episode) before the next episode's restore."""
+        self._spawned.append(name)
+
+    def run(self, k: int) -> RecordT:
+        """Run episode ``k`` (any order, any number of times: the same record for the same k)."""
+        w = self.world
+        for name in self._spawned:
+            if name in w.bodies:
+                w.remove_body(name)
+        self._spawned.clear()
+        w.restore(self._state)
+        t0, physics0 = time.perf_counter(), w.physics_seconds
+        recorder = self._recorder(k)
+        record = self.episode(k, recorder)
+        if recorder is not None:
+            recorder.save()
+        self.timing.per_episode.append(time.perf_counter() - t0)
+        self.timing.physics_per_episode.append(w.physics_seconds - physics0)
+        return record
+
+    def _recorder(self, k: int) -> FrameRecorder | None:
+        o = self.options
+        if k != o.record_episode:
+            return None
+        if o.recorder is not None:
+            return o.recorder(self.world)
+        return self.make_recorder(o.record) if o.record is not None else None
+
+    def close(self) -> None:
+        self.world.close()
+
+    def __enter__(self) -> EpisodeSession[RecordT]:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def run_batch(session: EpisodeSession[RecordT], options: RunOptions) -> tuple[list[RecordT], bool]:
+    """Episodes 0 .. ``options.episodes`` − 1 in order; before each, ``should_stop`` may end the
+    batch (then the second value, ``interrupted``, is True). ``on_episode`` sees every record."""
+    records: list[RecordT] = []
+    for k in range(options.episodes):
+        if options.stop_requested():
+            return records, True
+        record = session.run(k)
+        records.append(record)
+        if options.on_episode is not None:
+            options.on_episode(record)
+    return records, False
+
+
+class SingleRunSession:
+    """The session of a kind that runs one episode (gripper, trajectory, follow-target): episode
+    0 is the whole run and its record is the run's report."""
+
+    def __init__(self, runner: TaskRunner):
+        self.runner = runner
+
+    def run(self, k: int) -> Any:
+        if k != 0:
+            raise ValueError(f"'{self.runner.kind}' runs one episode: index {k} does not exist")
+        return self.runner.run().report
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self) -> SingleRunSession:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class EpisodicRunner(TaskRunner):
+    """A kind whose run is a batch of seeded episodes in one session."""
+
+    episodic = True
+
+    @abstractmethod
+    def open_session(self) -> EpisodeSession:
+        """Build the world and what episodes share (the caller closes it)."""
+
+    def run(self) -> RunOutput:
+        t0 = time.perf_counter()
+        with self.open_session() as session:
+            records, interrupted = run_batch(session, self.options)
+            report = session.report(records, interrupted)
+        session.timing.wall_time = time.perf_counter() - t0
+        return RunOutput(report, session.timing)

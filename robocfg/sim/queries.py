@@ -1,0 +1,86 @@
+"""What runners ask the physics besides stepping: ray casts, contacts, closest points, AABBs,
+dynamics changes, debug markers and GUI sliders — so that only ``robocfg.sim`` imports PyBullet.
+
+:class:`SceneQueries` is mixed into :class:`robocfg.sim.world.World`; every method takes bodies
+by name or id. World frame, metres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as p
+
+GUI_ERROR = p.error  # raised by GUI calls once the window is closed
+
+
+@dataclass(frozen=True)
+class RayHit:
+    """Where a ray met a body: its id and the hit point (world, m)."""
+
+    body: int
+    position: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class PairPoint:
+    """A closest point or contact between body ``a`` (link ``link_a``; −1 = base) and body ``b``;
+    ``distance`` (m) is negative when they penetrate."""
+
+    link_a: int
+    link_b: int
+    distance: float
+
+
+class SceneQueries:
+    """Physics queries of a world (needs ``client`` and ``body_id``)."""
+
+    client: int
+
+    def body_id(self, name_or_id: str | int) -> int:  # provided by World
+        raise NotImplementedError
+
+    def ray_hits(self, start: Sequence[float], end: Sequence[float]) -> list[RayHit]:
+        """Every body the segment ``start`` → ``end`` passes through (all hits, not only the first)."""
+        results = p.rayTestBatch([list(start)], [list(end)], reportHitNumber=-1, physicsClientId=self.client)
+        return [RayHit(int(h[0]), tuple(h[3])) for h in results if h[0] >= 0]
+
+    def closest_points(self, a: str | int, b: str | int, max_distance: float) -> list[PairPoint]:
+        """Closest points of bodies ``a`` and ``b`` nearer than ``max_distance`` (m), per link pair."""
+        pts = p.getClosestPoints(self.body_id(a), self.body_id(b), max_distance, physicsClientId=self.client)
+        return [PairPoint(int(c[3]), int(c[4]), float(c[8])) for c in pts]
+
+    def contact_points(self, a: str | int, b: str | int) -> list[PairPoint]:
+        """Contacts of the last physics step between bodies ``a`` and ``b``."""
+        pts = p.getContactPoints(self.body_id(a), self.body_id(b), physicsClientId=self.client)
+        return [PairPoint(int(c[3]), int(c[4]), float(c[8])) for c in pts]
+
+    def aabb(self, body: str | int, link: int = -1) -> tuple[np.ndarray, np.ndarray]:
+        """(min corner, max corner) of a body's (or link's) axis-aligned bounding box (world, m)."""
+        lo, hi = p.getAABB(self.body_id(body), link, physicsClientId=self.client)
+        return np.asarray(lo), np.asarray(hi)
+
+    def set_dynamics(self, body: str | int, link: int = -1, *, rolling_friction: float | None = None,
+                     spinning_friction: float | None = None, lateral_friction: float | None = None,
+                     mass: float | None = None) -> None:
+        """Change a body's dynamics; only the given values change (frictions unitless or m, mass kg)."""
+        kw = {k: v for k, v in (("rollingFriction", rolling_friction), ("spinningFriction", spinning_friction),
+                                ("lateralFriction", lateral_friction), ("mass", mass)) if v is not None}
+        p.changeDynamics(self.body_id(body), link, physicsClientId=self.client, **kw)
+
+    def add_marker(self, position: Sequence[float], radius: float = 0.015,
+                   rgba: Sequence[float] = (0.1, 0.8, 0.2, 0.8)) -> int:
+        """A sphere without collision, to show a point (GUI and recordings); returns its body id."""
+        vis = p.createVisualShape(p.GEOM_SPHERE, radius=radius, rgbaColor=list(rgba), physicsClientId=self.client)
+        return int(p.createMultiBody(0.0, -1, vis, [float(v) for v in position], physicsClientId=self.client))
+
+    def add_slider(self, label: str, low: float, high: float, value: float) -> int:
+        """A GUI slider (the debug panel is switched on); read it with :meth:`read_slider`."""
+        p.configureDebugVisualizer(p.COV_ENABLE_GUI, 1, physicsClientId=self.client)
+        return int(p.addUserDebugParameter(label, low, high, value, physicsClientId=self.client))
+
+    def read_slider(self, slider: int) -> float:
+        """The slider's value; raises :data:`GUI_ERROR` once the GUI window is closed."""
+        return float(p.readUserDebugParameter(slider, physicsClientId=self.client))
