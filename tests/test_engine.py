@@ -17,7 +17,14 @@ from test_golden_reports import GOLDEN, _assert_same
 
 import robocfg
 from robocfg.config.task import TASK_MODELS, params_model
-from robocfg.engine import EpisodeSpec, RunOptions, open_session, registered, run_episode, runner_for
+from robocfg.engine import (
+    EpisodeSpec,
+    RunOptions,
+    open_session,
+    registered,
+    run_episode,
+    runner_for,
+)
 from robocfg.engine.registry import command_name, unregister_task
 from robocfg.engine.spec import close_cached_session
 

@@ -74,13 +74,13 @@ class GraspReport(EpisodesReport):
     warnings: list[str] = field(default_factory=list)
     interrupted: bool = False
 
-    def summary_line(self, timing: BatchTiming | None) -> str:
+    def summary_line(self, timing: BatchTiming | None = None) -> str:
         s = self.summary
         ok = "ok" if s.successes == s.episodes else "failed"
         plan = f", planning median {timing.median_planning:.2f} s" if isinstance(timing, GraspTiming) else ""
         return f"{ok}: {self.robot} lifted {s.successes}/{s.episodes} ({s.success_rate:.1%}){plan}"
 
-    def view(self, timing: BatchTiming | None) -> ReportView:
+    def view(self, timing: BatchTiming | None = None) -> ReportView:
         s = self.summary
         failed = [e for e in self.episodes if not e.success]
         rows = [("episodes", str(s.episodes)),

@@ -70,13 +70,13 @@ class PickPlaceReport(EpisodesReport):
     warnings: list[str] = field(default_factory=list)
     interrupted: bool = False
 
-    def summary_line(self, timing: BatchTiming | None) -> str:
+    def summary_line(self, timing: BatchTiming | None = None) -> str:
         s = self.summary
         ok = "ok" if s.successes == s.episodes else "failed"
         return (f"{ok}: {self.robot} placed {s.successes}/{s.episodes} ({s.success_rate:.1%}), "
                 f"{s.mean_sim_time:.2f} s simulated per episode")
 
-    def view(self, timing: BatchTiming | None) -> ReportView:
+    def view(self, timing: BatchTiming | None = None) -> ReportView:
         s = self.summary
         failed = [e for e in self.episodes if not e.success]
         rows = [("episodes", str(s.episodes)), ("success", f"{s.successes}/{s.episodes} ({s.success_rate:.1%})"),
