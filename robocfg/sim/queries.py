@@ -42,10 +42,31 @@ class SceneQueries:
     def body_id(self, name_or_id: str | int) -> int:  # provided by World
         raise NotImplementedError
 
-    def ray_hits(self, start: Sequence[float], end: Sequence[float]) -> list[RayHit]:
-        """Every body the segment ``start`` → ``end`` passes through (all hits, not only the first)."""
-        results = p.rayTestBatch([list(start)], [list(end)], reportHitNumber=-1, physicsClientId=self.client)
-        return [RayHit(int(h[0]), tuple(h[3])) for h in results if h[0] >= 0]
+    def ray_hits(self, start: Sequence[float], end: Sequence[float], max_hits: int = 16) -> list[RayHit]:
+        """Every body (link) the segment ``start`` → ``end`` passes through, nearest first.
+
+        A PyBullet ray reports its closest hit only, so after each hit the ray is cast again from
+        just beyond the far side of the hit link's bounding box (an object resting on a fixture
+        would otherwise hide the fixture)."""
+        a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+        length = float(np.linalg.norm(b - a))
+        if length == 0.0:
+            return []
+        d = (b - a) / length
+        hits: list[RayHit] = []
+        s = a
+        for _ in range(max_hits):
+            h = p.rayTest(list(s), list(b), physicsClientId=self.client)[0]
+            if h[0] < 0:
+                break
+            hits.append(RayHit(int(h[0]), tuple(h[3])))
+            lo, hi = p.getAABB(h[0], h[1], physicsClientId=self.client)
+            exits = [((hi[k] if d[k] > 0 else lo[k]) - s[k]) / d[k] for k in range(3) if abs(d[k]) > 1e-12]
+            t = max(min(exits), 0.0) + 1e-4
+            if float(np.dot(s + t * d - a, d)) >= length:
+                break
+            s = s + t * d
+        return hits
 
     def closest_points(self, a: str | int, b: str | int, max_distance: float) -> list[PairPoint]:
         """Closest points of bodies ``a`` and ``b`` nearer than ``max_distance`` (m), per link pair."""
