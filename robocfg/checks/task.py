@@ -15,10 +15,11 @@ from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
-from robocfg.config.overrides import apply_overrides, blame_overrides
+from robocfg.config.overrides import OVERRIDE_SOURCE, apply_overrides, blame_overrides
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
 from robocfg.errors import ConfigError, NotFound, Problem
+from robocfg.suggest import did_you_mean
 
 _TASK_ADAPTER: tuple[tuple[str, ...], TypeAdapter] | None = None
 
@@ -58,15 +59,58 @@ def load_task(path: str | Path, strict: bool = False, robot_override: str | None
 
 def check_task_document(doc: YamlDocument, strict: bool = False, robot_override: str | None = None,
                         overrides: Mapping[str, Any] | None = None) -> CheckedTask:
-    """Validate a loaded task document and load and check the robots it names."""
-    if overrides:
-        doc = apply_overrides(doc, overrides)
+    """Validate a loaded task document and load and check the robots it names.
+
+    The ``variants`` entry of the robot that runs the task is applied first (user ``overrides``
+    win over it). Checking the file as written also checks every other robot's variant."""
+    changes = {**_variant(doc, robot_override, overrides), **(overrides or {})}
+    if changes:
+        doc = apply_overrides(doc, changes)
     elif robot_override is not None:
         doc = YamlDocument(doc.path, copy.deepcopy(doc.data), doc.marks)
     try:
-        return _check_document(doc, strict, robot_override)
+        checked = _check_document(doc, strict, robot_override)
     except ConfigError as exc:
-        raise blame_overrides(exc, overrides or {}) from None
+        raise blame_overrides(exc, changes) from None
+    if robot_override is None and not overrides:
+        _check_other_variants(doc, strict, checked.config.robots[0].robot)
+    return checked
+
+
+def _variant(doc: YamlDocument, robot_override: str | None, overrides: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The raw ``variants`` entry of the robot that will run (before validation; a malformed
+    ``variants`` block is left for validation to report)."""
+    variants = doc.data.get("variants") if isinstance(doc.data, dict) else None
+    name = robot_override or (overrides or {}).get("robots.0.robot")
+    if name is None and isinstance(doc.data, dict) and isinstance(doc.data.get("robots"), list) and doc.data["robots"]:
+        first = doc.data["robots"][0]
+        name = first.get("robot") if isinstance(first, dict) else None
+    entry = variants.get(name) if isinstance(variants, dict) and isinstance(name, str) else None
+    return dict(entry) if isinstance(entry, dict) else {}
+
+
+def _check_other_variants(doc: YamlDocument, strict: bool, running: str | None) -> None:
+    """Each ``variants`` entry checked with its robot: a robot name not on the search path, or a
+    variant that makes the task invalid, is an error at that entry."""
+    problems: list[Problem] = []
+    known = catalog.available("robots")
+    for name in doc.data.get("variants") or {}:
+        if name == running:
+            continue
+        loc = ("variants", name)
+        if name not in known:
+            problems.append(doc.problem(loc, f"no robot {name!r} on the search path{did_you_mean(name, known)}"))
+            continue
+        try:
+            check_task_document(doc, strict, robot_override=name)
+        except ConfigError as exc:
+            problems.append(doc.problem(loc, f"with robot {name!r} the task is invalid ({len(exc.problems)} problem(s) below)"))
+            # a problem inside a variant's value is shown at that value's line in this file
+            problems.extend(doc.problem(("variants", name, p.path), p.message)
+                            if p.file == OVERRIDE_SOURCE and p.path in doc.data["variants"][name] else p
+                            for p in exc.problems)
+    if problems:
+        raise ConfigError(problems)
 
 
 def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None) -> CheckedTask:

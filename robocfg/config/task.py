@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, JsonValue, model_validator
 
 from robocfg.config.cameras import TaskCamera
 from robocfg.config.commands import (
@@ -41,6 +41,12 @@ class TaskBase(Frozen):
     scene: Scene = Field(default_factory=Scene, description="Everything in the world besides the robots.")
     sim: Sim = Field(default_factory=Sim, description="Simulation settings.")
     cameras: list[TaskCamera] = Field(default_factory=list, description="Cameras recorded into datasets (--dataset); none: state only.")
+    variants: dict[str, dict[str, JsonValue]] = Field(
+        default_factory=dict,
+        description="Per-robot changes: robot name → {dotted key: value} (as `--set`), applied when that robot "
+                    "runs the task (first in `robots`, or chosen with `--robot`). For cells whose robots differ in "
+                    "reach: each robot gets fixtures and pick/place points it can reach.",
+    )
 
 
 class GripperTask(TaskBase):
