@@ -15,7 +15,7 @@ from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
-from robocfg.config.overrides import OVERRIDE_SOURCE, apply_overrides, blame_overrides
+from robocfg.config.overrides import apply_overrides, blame_overrides, parse_key
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
 from robocfg.errors import ConfigError, NotFound, Problem
@@ -62,8 +62,11 @@ def check_task_document(doc: YamlDocument, strict: bool = False, robot_override:
     """Validate a loaded task document and load and check the robots it names.
 
     The ``variants`` entry of the robot that runs the task is applied first (user ``overrides``
-    win over it). Checking the file as written also checks every other robot's variant."""
-    changes = {**_variant(doc, robot_override, overrides), **(overrides or {})}
+    win over it); a problem inside a variant's value is reported at its line in the file.
+    Checking the file as written also checks every other robot's variant."""
+    name, variant = _variant(doc, robot_override, overrides)
+    changes = {**variant, **(overrides or {})}
+    original = doc
     if changes:
         doc = apply_overrides(doc, changes)
     elif robot_override is not None:
@@ -71,22 +74,46 @@ def check_task_document(doc: YamlDocument, strict: bool = False, robot_override:
     try:
         checked = _check_document(doc, strict, robot_override)
     except ConfigError as exc:
-        raise blame_overrides(exc, changes) from None
+        exc = _blame_variant(exc, original, name, [k for k in variant if k not in (overrides or {})])
+        raise blame_overrides(exc, overrides or {}) from None
     if robot_override is None and not overrides:
-        _check_other_variants(doc, strict, checked.config.robots[0].robot)
+        _check_other_variants(original, strict, checked.config.robots[0].robot)
     return checked
 
 
-def _variant(doc: YamlDocument, robot_override: str | None, overrides: Mapping[str, Any] | None) -> dict[str, Any]:
-    """The raw ``variants`` entry of the robot that will run (before validation; a malformed
+def _variant(doc: YamlDocument, robot_override: str | None,
+             overrides: Mapping[str, Any] | None) -> tuple[str | None, dict[str, Any]]:
+    """The robot that will run and its raw ``variants`` entry (before validation; a malformed
     ``variants`` block is left for validation to report)."""
-    variants = doc.data.get("variants") if isinstance(doc.data, dict) else None
+    data = doc.data if isinstance(doc.data, dict) else {}
     name = robot_override or (overrides or {}).get("robots.0.robot")
-    if name is None and isinstance(doc.data, dict) and isinstance(doc.data.get("robots"), list) and doc.data["robots"]:
-        first = doc.data["robots"][0]
-        name = first.get("robot") if isinstance(first, dict) else None
+    robots = data.get("robots")
+    if name is None and isinstance(robots, list) and robots and isinstance(robots[0], dict):
+        name = robots[0].get("robot")
+    variants = data.get("variants")
     entry = variants.get(name) if isinstance(variants, dict) and isinstance(name, str) else None
-    return dict(entry) if isinstance(entry, dict) else {}
+    return (name if isinstance(name, str) else None), (dict(entry) if isinstance(entry, dict) else {})
+
+
+def _blame_variant(exc: ConfigError, doc: YamlDocument, name: str | None, keys: list[str]) -> ConfigError:
+    """Problems inside a variant's value, located at that value in the file
+    (``variants.NAME.pick_place.place_position[0]``)."""
+    locs = []
+    for k in keys:
+        try:
+            locs.append((parse_key(k), k))
+        except ConfigError:
+            continue
+    out = []
+    for prob in exc.problems:
+        try:
+            loc = parse_key(prob.path) if prob.path else ()
+        except ConfigError:
+            loc = ()
+        hit = next(((kl, k) for kl, k in locs if loc[: len(kl)] == kl), None)
+        out.append(doc.problem(("variants", name, hit[1], *loc[len(hit[0]):]), prob.message, prob.severity)
+                   if hit and name is not None else prob)
+    return ConfigError(out)
 
 
 def _check_other_variants(doc: YamlDocument, strict: bool, running: str | None) -> None:
@@ -105,10 +132,7 @@ def _check_other_variants(doc: YamlDocument, strict: bool, running: str | None) 
             check_task_document(doc, strict, robot_override=name)
         except ConfigError as exc:
             problems.append(doc.problem(loc, f"with robot {name!r} the task is invalid ({len(exc.problems)} problem(s) below)"))
-            # a problem inside a variant's value is shown at that value's line in this file
-            problems.extend(doc.problem(("variants", name, p.path), p.message)
-                            if p.file == OVERRIDE_SOURCE and p.path in doc.data["variants"][name] else p
-                            for p in exc.problems)
+            problems.extend(exc.problems)
     if problems:
         raise ConfigError(problems)
 
