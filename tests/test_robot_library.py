@@ -224,3 +224,79 @@ def test_authored_robot_runs_its_own_pick_place(task_name, robot):
     task = load_task(catalog.find("tasks", task_name), robot_override=robot)
     report, _ = run_pick_place(task, episodes=1, seed=1)
     _placed(report, task)
+
+
+# ---- a dual-arm robot on a torso lift ---------------------------------------------------------
+
+
+class _LiftWatch(_ArmWatch):
+    def maybe_capture(self) -> None:
+        super().maybe_capture()
+        lift = float(self.world.robot.joint_positions(["lift_joint"])[0])
+        self.max_dev["lift"] = max(self.max_dev.get("lift", 0.0), abs(lift - 0.15))
+
+
+@pytest.mark.parametrize("arm", ["left", "right"])
+def test_dual_arm_lift_picks_with_either_arm_while_the_lift_stays_locked(arm):
+    task = load_task(catalog.find("tasks", "pick_place_dual_arm_lift"))
+    assert task.robots[0].config.locked_joints == {"lift_joint": 0.15}
+    watches: list[_LiftWatch] = []
+
+    def record(world):
+        watches.append(_LiftWatch(world))
+        return watches[-1]
+
+    report, _ = run_pick_place(task, episodes=1, arm=arm, record=record)
+    _placed(report, task)
+    w = watches[0]
+    other = "right" if arm == "left" else "left"
+    assert w.max_dev["lift"] < 1e-3, f"the lift moved {w.max_dev['lift'] * 1000:.1f} mm"
+    assert w.max_dev[other] < 1e-3 and w.max_dev[arm] > 0.3
+
+
+def _lift_in_the_left_arm(tmp_path, keep_locked: bool = False):
+    """The other robot-YAML choice: lift_joint first in the left arm's chain (IK moves it)."""
+    import yaml
+
+    src = catalog.find("robots", "dual_arm_lift")
+    data = yaml.safe_load(src.read_text())
+    data["urdf"] = str(src.parent / data["urdf"])
+    left = data["arms"][0]
+    left["joints"] = ["lift_joint", *left["joints"]]
+    left["home"] = [0.15, *left["home"]]
+    left["home_std"] = [0.01, *left["home_std"]]
+    left["base_link"] = "base_link"
+    if not keep_locked:
+        del data["locked_joints"]
+    path = tmp_path / "lift_ik.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_dual_arm_lift_as_an_ik_joint_reaches_higher(tmp_path):
+    """With the lift in the left arm's chain IK uses it: a TCP target 0.5 m above the locked arm's
+    reach is solved by raising the lift, and FK of the answer lands on the target."""
+    from robocfg.kinematics.ik.lm import LMSolver
+    from robocfg.kinematics.model import KinematicModel
+
+    robot = load_robot(_lift_in_the_left_arm(tmp_path))
+    model = KinematicModel.from_robot(robot, arm="left")
+    assert model.nq == 8
+    home = np.asarray(robot.config.arm("left").home)
+    target = model.fk(home, "tcp")
+    target[2, 3] += 0.4  # beyond the locked arm: its home TCP is already near full height
+    res = LMSolver(model).solve(target, home, time_budget=0.5)
+    assert res.converged, (res.pos_err, res.rot_err)
+    assert res.q[0] > 0.3  # the lift rose
+    np.testing.assert_allclose(model.fk(res.q, "tcp")[:3, 3], target[:3, 3], atol=1e-4)
+    locked = KinematicModel.from_robot(load_robot(catalog.find("robots", "dual_arm_lift")), arm="left")
+    assert locked.nq == 7
+    assert not LMSolver(locked).solve(target, home[1:], time_budget=0.2).converged
+
+
+def test_a_locked_joint_that_an_arm_drives_is_an_error(tmp_path):
+    from robocfg.errors import ConfigError
+
+    with pytest.raises(ConfigError) as exc:
+        load_robot(_lift_in_the_left_arm(tmp_path, keep_locked=True))
+    assert "locked_joints.lift_joint: 'lift_joint' is an arm or gripper joint" in str(exc.value)

@@ -321,6 +321,18 @@ def _check_tcp(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGr
 
 def _check_drives_and_physics(c: _Collector, robot: CheckedRobot) -> None:
     cfg, urdf = robot.config, robot.urdf
+    driven = {n for a in cfg.arms for n in robot.arm_joints(a) + robot.gripper_joints(a)}
+    for name, q in cfg.locked_joints.items():
+        loc = ("locked_joints", name)
+        if not _known(c, loc, name, [j.name for j in urdf.joints.values() if j.movable], "movable joint"):
+            continue
+        j = urdf.joints[name]
+        if name in driven:
+            c.error(loc, f"{name!r} is an arm or gripper joint: it is driven, not locked (remove it from one of the two)")
+        elif j.mimic is not None:
+            c.error(loc, f"{name!r} follows {j.mimic.joint!r} by a <mimic> tag: lock the leader instead")
+        elif not j.lower <= q <= j.upper:
+            c.error(loc, f"{name} = {q:.4f} is outside the limits [{j.lower:.4f}, {j.upper:.4f}]")
     for key in ("velocity_limits", "acceleration_limits"):
         for name in getattr(cfg.drives, key):
             _known(c, ("drives", key, name), name, list(urdf.joints), "joint")

@@ -197,6 +197,12 @@ class RobotConfig(Frozen):
     fixed_base: bool = Field(True, description="Weld the URDF root link to the world (PyBullet useFixedBase).")
     arms: list[ArmConfig] = Field(min_length=1, description="One entry per arm.")
     drives: Drives = Field(default_factory=Drives, description="Drive gains and joint-limit overrides.")
+    locked_joints: dict[str, FiniteFloat] = Field(
+        default_factory=dict,
+        description="Joints no arm or gripper moves, held at these positions (m or rad): position-driven there "
+                    "(at the URDF effort limit) in the simulation and locked there in the kinematic model, e.g. a "
+                    "torso lift at its home height. Joints neither listed nor driven stay at 0 (clipped into their limits).",
+    )
     physics: Physics = Field(default_factory=Physics, description="Solver settings and link-mass overrides.")
     ik_backend: str = Field("lm", description=f"Default IK backend name: {', '.join(IK_BACKENDS)}.")
 

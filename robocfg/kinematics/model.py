@@ -274,10 +274,11 @@ def _frame_id(model: pin.Model, name: str) -> int:
 
 
 def _locked_values(robot: CheckedRobot, arm_name: str, overrides: dict[str, float]) -> dict[str, float]:
-    """Values of the locked joints: grippers open, other arms at home, mimic followers following."""
+    """Values of the locked joints: the robot's ``locked_joints``, grippers open, other arms at home,
+    mimic followers following."""
     from robocfg.config.robot import ParallelGripperConfig
 
-    values: dict[str, float] = {}
+    values: dict[str, float] = dict(robot.config.locked_joints)
     for a in robot.config.arms:
         if a.name != arm_name:
             values.update(zip(robot.arm_joints(a), a.home, strict=True))

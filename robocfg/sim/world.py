@@ -143,6 +143,11 @@ class World(SceneQueries):
         for arm in robot.arms.values():
             robot.reset_joints(arm.joints, arm.home, hold=False)
             arm.command(arm.home)
+        locked = checked.config.locked_joints
+        if locked:  # held at their positions with the URDF's effort limit (a lift carries the arms)
+            robot.reset_joints(list(locked), list(locked.values()), hold=False)
+            robot.command_positions(list(locked), list(locked.values()),
+                                    forces=[checked.urdf.joints[n].effort for n in locked])
         others = [n for n in robot.movable_joints if n not in followers and n not in robot.drives]
         gripper_joints = {n for a in robot.arms.values() for n in checked.gripper_joints(a.config)}
         rest = [n for n in others if n not in gripper_joints]
