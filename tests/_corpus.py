@@ -98,6 +98,14 @@ def _validate(fname: str, data_or_text, exit_: int, field_: str | None = None, n
     return Case(name or fname, {fname: text}, ["validate", "{dir}/" + fname], exit_, fname if exit_ else None, field_, expect)
 
 
+def _typo_expect(path: tuple) -> str:
+    """A misspelt schema key is an unknown key; a misspelt name used as a key (a joint in a
+    waypoint map, a robot in ``variants``) gets a suggestion."""
+    if (path[:2] == ("trajectory", "waypoints") and len(path) == 4) or (path[:1] == ("variants",) and len(path) == 2):
+        return "did you mean"
+    return "unknown key"
+
+
 def task_cases(rng: random.Random) -> list[Case]:
     cases = []
     for path in sorted(TASKS.glob("*.yaml")):
@@ -112,7 +120,8 @@ def task_cases(rng: random.Random) -> list[Case]:
         for p in rng.sample(keys, min(TYPOS_PER_TASK, len(keys))):
             typo = p[-1][:-1] + p[-1][-1].upper() + "x"
             cases.append(_validate(f"{stem}-typo-{format_loc(p)}.yaml", _rename(base, p, typo), 2,
-                                   format_loc((*p[:-1], typo)), name=f"task-typo-{stem}-{format_loc(p)}", expect="unknown key"))
+                                   format_loc((*p[:-1], typo)), name=f"task-typo-{stem}-{format_loc(p)}",
+                                   expect=_typo_expect(p)))
     return cases
 
 

@@ -21,8 +21,12 @@ class _ArmWatch(EpisodeObserver):
         self.world, self.max_dev, self.at_end = world, {}, {}
 
     def maybe_capture(self) -> None:
-        for name, arm in self.world.robot.arms.items():
+        robot = self.world.robot
+        for name, arm in robot.arms.items():
             dev = float(np.abs(arm.joint_positions() - arm.home).max())
+            self.max_dev[name] = max(self.max_dev.get(name, 0.0), dev)
+        for name, q in robot.config.locked_joints.items():  # e.g. a torso lift held at its home
+            dev = abs(float(robot.joint_positions([name])[0]) - q)
             self.max_dev[name] = max(self.max_dev.get(name, 0.0), dev)
 
     def save(self) -> None:
@@ -36,9 +40,12 @@ def _placed(report, task) -> None:
     assert np.linalg.norm(final[:2] - np.asarray(e.place_target)) <= task.config.pick_place.success_tolerance
 
 
+@pytest.mark.parametrize(("task_name", "robot"), [("pick_place", "dual_panda"), ("pick_place_dual_arm_lift", None)],
+                         ids=["dual_panda", "dual_arm_lift"])
 @pytest.mark.parametrize("arm", ["left", "right"])
-def test_dual_arm_cell_picks_with_either_arm_while_the_other_holds(arm):
-    task = load_task(catalog.find("tasks", "pick_place"), robot_override="dual_panda")
+def test_dual_arm_cell_picks_with_either_arm_while_the_other_holds(arm, task_name, robot):
+    """The idle arm and any locked joint (dual_arm_lift's torso lift) stay where they are."""
+    task = load_task(catalog.find("tasks", task_name), robot_override=robot)
     watches: list[_ArmWatch] = []
 
     def record(world):
@@ -52,6 +59,8 @@ def test_dual_arm_cell_picks_with_either_arm_while_the_other_holds(arm):
     w = watches[0]
     assert w.max_dev[other] < 1e-3, f"the idle arm moved {w.max_dev[other]:.2e} rad"
     assert w.max_dev[arm] > 0.3  # the working arm really moved
+    for name in task.robots[0].config.locked_joints:
+        assert w.max_dev[name] < 1e-3, f"locked joint {name} moved {w.max_dev[name]:.2e}"
 
 
 def test_industrial_arm_on_a_yawed_pedestal_moves_a_heavy_box():
@@ -169,7 +178,7 @@ def test_authored_maira7m_has_seven_axes_with_the_published_ranges():
     assert stretched[0] == pytest.approx(1.0)  # reach from the shoulder axis to the flange
 
 
-class _SlipWatch:
+class _SlipWatch(EpisodeObserver):
     """A ``record=`` stand-in that follows the carried object in the suction-cup frame: slip is
     how far it moves there from where it sat at the start of the lift (m); ``carried`` is the
     path length (m) the object travels during the transport phase."""
@@ -193,9 +202,6 @@ class _SlipWatch:
         if self.phase == "transport" and self.last is not None:
             self.carried += float(np.linalg.norm(pos - self.last))
         self.last = pos
-
-    def save(self) -> None:
-        pass
 
 
 @pytest.mark.parametrize("robot", ["kuka_kr210", "abb_irb7600", "neura_maira7m"])
@@ -229,31 +235,6 @@ def test_authored_robot_runs_its_own_pick_place(task_name, robot):
 # ---- a dual-arm robot on a torso lift ---------------------------------------------------------
 
 
-class _LiftWatch(_ArmWatch):
-    def maybe_capture(self) -> None:
-        super().maybe_capture()
-        lift = float(self.world.robot.joint_positions(["lift_joint"])[0])
-        self.max_dev["lift"] = max(self.max_dev.get("lift", 0.0), abs(lift - 0.15))
-
-
-@pytest.mark.parametrize("arm", ["left", "right"])
-def test_dual_arm_lift_picks_with_either_arm_while_the_lift_stays_locked(arm):
-    task = load_task(catalog.find("tasks", "pick_place_dual_arm_lift"))
-    assert task.robots[0].config.locked_joints == {"lift_joint": 0.15}
-    watches: list[_LiftWatch] = []
-
-    def record(world):
-        watches.append(_LiftWatch(world))
-        return watches[-1]
-
-    report, _ = run_pick_place(task, episodes=1, arm=arm, record=record)
-    _placed(report, task)
-    w = watches[0]
-    other = "right" if arm == "left" else "left"
-    assert w.max_dev["lift"] < 1e-3, f"the lift moved {w.max_dev['lift'] * 1000:.1f} mm"
-    assert w.max_dev[other] < 1e-3 and w.max_dev[arm] > 0.3
-
-
 def _lift_in_the_left_arm(tmp_path, keep_locked: bool = False):
     """The other robot-YAML choice: lift_joint first in the left arm's chain (IK moves it)."""
     import yaml
@@ -271,6 +252,12 @@ def _lift_in_the_left_arm(tmp_path, keep_locked: bool = False):
     path = tmp_path / "lift_ik.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path
+
+
+def test_dual_arm_lift_is_locked_at_its_home_height():
+    robot = load_robot(catalog.find("robots", "dual_arm_lift"))
+    assert robot.config.locked_joints == {"lift_joint": 0.15}
+    assert robot.urdf.joints["lift_joint"].type == "prismatic"
 
 
 def test_dual_arm_lift_as_an_ik_joint_reaches_higher(tmp_path):
