@@ -136,7 +136,7 @@ def test_R_ee_graspnet_convention_for_panda():
 def test_tcp_offset_far_from_the_pads_warns_and_strict_fails(tmp_path):
     robot = load_robot(DATA / "panda_off_tcp.yaml")
     [w] = robot.warnings
-    assert w.path == "arms[0].tcp_offset" and "0.1034 m along z" in w.message
+    assert w.path == "arms[0].tcp_offset" and "0.1022 m along z" in w.message
     assert "arms[0].tcp_offset" in errors(DATA / "panda_off_tcp.yaml", strict=True)
     assert load_robot(panda(tmp_path, ("tcp_offset: 0.1034", "tcp_offset: 0.108"))).warnings == []  # within 10 mm
 
@@ -200,12 +200,16 @@ arms:
 """
 
 
-def test_moving_link_without_inertial_warns_until_given_a_mass(tmp_path):
+def test_every_link_without_inertial_warns_until_given_a_mass(tmp_path):
+    """The moving 'arm' and the fixed-joint child 'tool' alike: each would load as 1 kg in PyBullet."""
     (tmp_path / "two_link.urdf").write_text(TWO_LINK_URDF)
     robot = load_robot(write(tmp_path, TWO_LINK_YAML))
-    [w] = robot.warnings
-    assert w.path == "physics.link_masses" and "'arm'" in w.message
-    fixed = load_robot(write(tmp_path, TWO_LINK_YAML + "physics:\n  link_masses: {arm: 0.5}\n"))
+    w_arm, w_tool = sorted(robot.warnings, key=lambda w: "'tool'" in w.message)
+    assert w_arm.path == w_tool.path == "physics.link_masses"
+    assert "'arm'" in w_arm.message and "'tool' has no <inertial>" in w_tool.message and "0.001 kg" in w_tool.message
+    half = load_robot(write(tmp_path, TWO_LINK_YAML + "physics:\n  link_masses: {arm: 0.5}\n"))
+    assert [w.message for w in half.warnings] == [w_tool.message]
+    fixed = load_robot(write(tmp_path, TWO_LINK_YAML + "physics:\n  link_masses: {arm: 0.5, tool: 0.001}\n"))
     assert fixed.warnings == []
 
 

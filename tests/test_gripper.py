@@ -16,7 +16,7 @@ PANDA = next(f for f in SHIPPED_ROBOTS if f.stem == "panda")
 
 def test_registry_known_unknown_duplicate():
     assert GRIPPERS["parallel"] is ParallelGripper and "suction" in GRIPPERS
-    with pytest.raises(NotFound, match=r"suctoin.*did you mean 'suction'.*known: parallel, suction"):
+    with pytest.raises(NotFound, match=r"suctoin.*did you mean 'suction'.*known: one_jaw, parallel, suction"):
         gripper_class("suctoin")
     with pytest.raises(RobocfgError, match="already registered"):
         register("parallel")(type("Other", (Gripper,), {}))

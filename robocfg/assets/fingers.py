@@ -55,7 +55,15 @@ def pad_points(urdf: Urdf, ee_link: str, finger_links: list[str], points: list[n
         T = T_ee_inv @ urdf.link_pose(name, q)
         P_ee = P @ T[:3, :3].T + T[:3, 3]
         tip, base = P_ee[:, axis].max(), P_ee[:, axis].min()
-        out.append(P_ee[P_ee[:, axis] >= tip - PAD_LENGTH] if tip - base > 2 * PAD_LENGTH else P_ee)
+        if tip - base <= 2 * PAD_LENGTH:
+            out.append(P_ee)
+            continue
+        # The distal points, plus their copies moved back to the pad's start: the pad spans the whole
+        # PAD_LENGTH along the axis even when the geometry has no vertex there (a box's corners).
+        pad = P_ee[P_ee[:, axis] >= tip - PAD_LENGTH]
+        back = pad.copy()
+        back[:, axis] = tip - PAD_LENGTH
+        out.append(np.vstack([pad, back]))
     return out
 
 

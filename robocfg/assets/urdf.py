@@ -131,6 +131,16 @@ class Urdf:
         return out
 
 
+FRAME_LINK_MASS = 0.001  # kg given to a link without <inertial> and without collision geometry (a frame)
+SOLID_LINK_MASS = 0.01  # kg given to a link without <inertial> that has collision geometry (a pad, a bracket)
+
+
+def missing_link_mass(link: Link) -> float:
+    """Mass (kg) robocfg loads a link without ``<inertial>`` with, where PyBullet would use 1 kg:
+    light enough not to load the arm or tilt a gripper, heavy enough for a stable solver."""
+    return SOLID_LINK_MASS if link.collisions else FRAME_LINK_MASS
+
+
 def joint_motion(j: Joint, value: float) -> np.ndarray:
     T = np.eye(4)
     if j.type in ("revolute", "continuous"):

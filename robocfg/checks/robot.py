@@ -11,11 +11,24 @@ from pathlib import Path
 
 import numpy as np
 
-from robocfg.assets.fingers import FingerGeometryMissing, finger_points, pad_midpoint, pad_points
+from robocfg.assets.fingers import (
+    FingerGeometryMissing,
+    closing_axis,
+    finger_points,
+    pad_midpoint,
+    pad_points,
+)
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import Urdf, UrdfParseError, parse_urdf
+from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass, parse_urdf
+from robocfg.checks.tool_point import check_one_jaw, check_suction
 from robocfg.config.load import Loc, YamlDocument, load_yaml, validate_document
-from robocfg.config.robot import ArmConfig, ParallelGripperConfig, RobotConfig, SuctionGripperConfig
+from robocfg.config.robot import (
+    ArmConfig,
+    OneJawGripperConfig,
+    ParallelGripperConfig,
+    RobotConfig,
+    SuctionGripperConfig,
+)
 from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import ConfigError, Problem
 from robocfg.suggest import did_you_mean
@@ -230,6 +243,8 @@ def _check_arm(c: _Collector, robot: CheckedRobot, arm: ArmConfig, loc: Loc, res
         chain = urdf.chain(arm.ee_link, g.link) if arm.ee_link in links else []
         if chain is None or any(j.movable for j in chain):
             c.error((*loc, "gripper", "link"), f"suction link {g.link!r} must be rigidly attached below ee_link {arm.ee_link!r}")
+        else:
+            check_suction(c.warn, urdf, resolver, arm, g, (*loc, "tcp_offset"), (*loc, "gripper", "link"))
 
 
 def _check_joint_list(c: _Collector, urdf: Urdf, names: list[str] | None, indices: list[int] | None,
@@ -289,6 +304,8 @@ def _check_parallel(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: Paral
     finger_ok = all(_known(c, (*loc, "finger_links", k), f, list(urdf.links), "link") for k, f in enumerate(g.finger_links))
     if finger_ok and arm.ee_link in urdf.links:
         _check_tcp(c, robot, arm, g, leaders, loc, resolver)
+        if isinstance(g, OneJawGripperConfig):
+            check_one_jaw(c.warn, urdf, resolver, arm, g, leaders, loc)
 
 
 def _check_tcp(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGripperConfig,
@@ -306,7 +323,10 @@ def _check_tcp(c: _Collector, robot: CheckedRobot, arm: ArmConfig, g: ParallelGr
         return  # a missing mesh is already reported
     mids = [pad_midpoint(pad_points(urdf, arm.ee_link, list(g.finger_links), points, dict(zip(leaders, qs, strict=True)), axis))
             for qs in (g.open, g.closed)]
-    mid = mids[0]
+    mid = mids[0].copy()
+    if isinstance(g, OneJawGripperConfig):  # its grasp centre is off the axis by design (grasp_side_shift)
+        c_dir = closing_axis(arm.R_ee_graspnet)
+        mid -= (mid @ c_dir) * c_dir
     along = mid[axis]
     angle = np.degrees(np.arccos(np.clip(along / max(np.linalg.norm(mid), 1e-9), -1, 1)))
     lo, hi = sorted(float(m[axis]) for m in mids)
@@ -338,9 +358,14 @@ def _check_drives_and_physics(c: _Collector, robot: CheckedRobot) -> None:
             _known(c, ("drives", key, name), name, list(urdf.joints), "joint")
     for name in cfg.physics.link_masses:
         _known(c, ("physics", "link_masses", name), name, list(urdf.links), "link")
+    # Every link but the root counts: a fixed-joint child (a flange frame, a finger pad, an
+    # attachment's root) weighs on the arm and the gripper as much as a moving one.
     for j in urdf.joints.values():
-        if not j.movable:
+        link = urdf.links.get(j.child)
+        if not link or j.child in cfg.physics.link_masses:
             continue
-        moved = urdf.links.get(j.child)
-        if moved and (moved.mass is None or moved.mass <= 0) and j.child not in cfg.physics.link_masses:
-            c.warn(("physics", "link_masses"), f"moving link {j.child!r} has no <inertial> or zero mass (PyBullet would make it 1 kg); set physics.link_masses.{j.child}")
+        if link.mass is None:
+            c.warn(("physics", "link_masses"), f"link {j.child!r} has no <inertial>: PyBullet would make it 1 kg, robocfg "
+                   f"loads it as {missing_link_mass(link):g} kg; set physics.link_masses.{j.child} to its real mass")
+        elif link.mass <= 0 and j.movable:
+            c.warn(("physics", "link_masses"), f"moving link {j.child!r} has zero mass; set physics.link_masses.{j.child}")

@@ -68,16 +68,34 @@ class ParallelGripperConfig(Frozen):
         return self
 
 
+class OneJawGripperConfig(ParallelGripperConfig):
+    """A one-jaw gripper: one driven jaw closes against a jaw fixed to the hand (Unitree Z1 style).
+
+    Everything a parallel gripper has, with ``finger_links: [moving jaw, fixed jaw]`` and the
+    closing direction (grasp y, row 1 of ``R_ee_graspnet``) pointing from the moving jaw towards the
+    fixed one. The object ends up against the fixed jaw, so the grasp centre is not on the ee_axis
+    line: it is mid-way between the jaw faces at the grasp width, ``fixed_jaw_face − width/2`` along
+    the closing direction. ``tcp_offset`` stays the distance along ``ee_axis`` to the jaw pads.
+    """
+
+    type: Literal["one_jaw"] = Field("one_jaw", description="Gripper kind (selects this block).")  # type: ignore[assignment]
+    fixed_jaw_face: FiniteFloat = Field(
+        description="Signed distance (m) from the ee_axis line to the fixed jaw's inner face, along the closing "
+        "direction (grasp y); robocfg validate measures it from the collision geometry.",
+    )
+
+
 class SuctionGripperConfig(Frozen):
     """A suction cup: attaches an object by a constraint when the cup touches it."""
 
     type: Literal["suction"] = Field("suction", description="Gripper kind (selects this block).")
-    link: str = Field(description="The suction-cup link (its frame is at the cup face).")
+    link: str = Field(description="The suction-cup link; the TCP (tcp_offset along ee_axis) is its cup face, the "
+                      "point of its geometry furthest along ee_axis.")
     hold_force: PositiveFloat = Field(50.0, description="Largest pulling load (N) before the object lets go.")
     activation_distance: NonNegFloat = Field(0.005, description="Max gap (m) between cup and object to attach.")
 
 
-GripperConfig = Annotated[ParallelGripperConfig | SuctionGripperConfig, Field(discriminator="type")]
+GripperConfig = Annotated[ParallelGripperConfig | OneJawGripperConfig | SuctionGripperConfig, Field(discriminator="type")]
 
 
 class GripperKeypoints(Frozen):

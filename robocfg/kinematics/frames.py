@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robocfg.config.robot import ArmConfig
+from robocfg.config.robot import ArmConfig, OneJawGripperConfig
 from robocfg.config.types import AXIS_INDEX
 
 
@@ -42,11 +42,26 @@ def grasp_rotation(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
     return np.column_stack([x, y, np.cross(x, y)])
 
 
+def grasp_side_shift(arm: ArmConfig, width: float) -> float:
+    """Where the grasp centre lies across the ee_axis line, along the closing direction (m).
+
+    0 for grippers whose jaws close symmetrically about the TCP. A one-jaw gripper pushes the
+    object against its fixed jaw, so the object's centre ends ``fixed_jaw_face − width/2`` from
+    the line (the moving jaw comes from the −closing side)."""
+    g = arm.gripper
+    if isinstance(g, OneJawGripperConfig):
+        return float(g.fixed_jaw_face - width / 2)
+    return 0.0
+
+
 def ee_pose_from_grasp(grasp: Grasp, arm: ArmConfig, standoff: float = 0.0) -> np.ndarray:
     """World pose of ``ee_link`` that puts the TCP at the grasp centre (moved back along the
-    approach by ``standoff`` metres), with ``world_R_ee = world_R_grasp · R_ee_graspnet``."""
+    approach by ``standoff`` metres), with ``world_R_ee = world_R_grasp · R_ee_graspnet``.
+    For a one-jaw gripper the EE is also moved across by :func:`grasp_side_shift` at the grasp's
+    width, so the fixed jaw's face lands on the object's side instead of inside it."""
     R_ee = grasp.rotation @ np.asarray(arm.R_ee_graspnet, float)
     tcp = np.asarray(grasp.center, float) - standoff * grasp.approach()
+    tcp = tcp - grasp_side_shift(arm, grasp.width) * grasp.closing()
     T = np.eye(4)
     T[:3, :3] = R_ee
     T[:3, 3] = tcp - arm.tcp_offset * R_ee[:, AXIS_INDEX[arm.ee_axis]]

@@ -79,6 +79,9 @@ class KinematicModel:
     locked: dict[str, float] = field(default_factory=dict)  # locked joint → value (rad or m)
     default_backend: str = "lm"
     robot: CheckedRobot | None = field(default=None, repr=False)  # source config (collision geometry for IK)
+    # bool, arm-joint order: URDF continuous joints. The solvers work in [-π, π] (``lower``/``upper``);
+    # ``ik`` then returns each continuous joint at the turn nearest to the seed, unbounded.
+    continuous: np.ndarray | None = None
     _solvers: dict[str, IKSolver] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
@@ -166,6 +169,7 @@ class KinematicModel:
             locked={full.names[j]: float(q_full[full.joints[j].idx_q]) for j in lock_ids},
             default_backend=cfg.ik_backend,
             robot=robot,
+            continuous=np.array([n in continuous for n in arm_joints], dtype=bool),
         )
 
     # ------------------------------------------------------------------ queries
@@ -207,8 +211,12 @@ class KinematicModel:
         return pin.computeFrameJacobian(self.model, self.data, q, fid, pin.LOCAL_WORLD_ALIGNED).copy()
 
     def within_limits(self, q: np.ndarray, tol: float = 1e-9) -> bool:
+        """True when every joint is within its limits (continuous joints have none)."""
         q = np.asarray(q, dtype=float)
-        return bool(np.all(q >= self.lower - tol) and np.all(q <= self.upper + tol))
+        inside = (q >= self.lower - tol) & (q <= self.upper + tol)
+        if self.continuous is not None:
+            inside |= self.continuous
+        return bool(np.all(inside))
 
     def ik(
         self,
@@ -225,15 +233,18 @@ class KinematicModel:
         ``seed_q`` defaults to the arm's home. ``time_budget`` (s) bounds the search (random
         restarts inside it); ``backend`` defaults to the robot YAML's ``ik_backend``.
         ``rng`` drives the restarts (default: ``default_rng(0)``, so results are reproducible).
+        Continuous joints come back at the turn nearest to the seed (outside [-π, π] when it is).
         Never raises for unreachable targets (``converged=False`` with the best residual);
         raises RobocfgError for a NaN/inf or malformed target.
         """
         solver = self.solver(backend)
-        return solver.solve(
-            target, seed_q=self.home if seed_q is None else np.asarray(seed_q, dtype=float), frame=frame,
-            time_budget=time_budget, position_only=position_only,
-            rng=rng,
-        )
+        seed = self.home if seed_q is None else np.asarray(seed_q, dtype=float)
+        res = solver.solve(target, seed_q=seed, frame=frame, time_budget=time_budget, position_only=position_only, rng=rng)
+        if self.continuous is not None and self.continuous.any() and np.all(np.isfinite(seed)):
+            # The same pose with the least travel from the seed: a wrist at π+0.1 stays there, not at −π+0.1.
+            turns = np.round((seed - res.q) / (2 * math.pi))
+            res.q = np.where(self.continuous, res.q + 2 * math.pi * turns, res.q)
+        return res
 
     def solver(self, backend: str | None = None) -> IKSolver:
         """The (cached) solver instance of ``backend`` (default: the robot YAML's ``ik_backend``),

@@ -3,7 +3,9 @@
 * Mesh ``package://`` URIs are resolved with the robot YAML's ``package_dirs`` (our Resolver) and a
   rewritten copy of the URDF with absolute mesh paths is loaded (cached in the temp folder).
 * ``physics.link_masses`` become ``<inertial>`` blocks in that copy (inertia of a 2 cm cube of that
-  mass), so links without ``<inertial>`` do not load as 1 kg.
+  mass); every other link without ``<inertial>`` (the root excepted) gets a small one too —
+  ``missing_link_mass``: 0.01 kg with collision geometry, 0.001 kg for a bare frame — where
+  PyBullet would load it as 1 kg (``robocfg validate`` warns about each such link).
 * PyBullet's C-level messages are captured; a mesh PyBullet cannot read (it then silently loads the
   link with no collision shape) or cannot find raises ConfigError naming the mesh.
 """
@@ -20,7 +22,7 @@ from pathlib import Path
 import pybullet as p
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import read_urdf_xml
+from robocfg.assets.urdf import FRAME_LINK_MASS, missing_link_mass, read_urdf_xml
 from robocfg.checks.robot import CheckedRobot
 from robocfg.errors import ConfigError
 from robocfg.sim.quiet import captured_stdout
@@ -46,8 +48,12 @@ def prepared_urdf(robot: CheckedRobot) -> Path:
                 mesh.set("filename", str(resolved))
                 changed = True
     changed |= _split_multi_material_visuals(root)
+    children = {c.get("link") for j in root.findall("joint") for c in j.findall("child")}
     for link in root.findall("link"):
-        mass = cfg.physics.link_masses.get(link.get("name", ""))
+        name = link.get("name", "")
+        mass = cfg.physics.link_masses.get(name)
+        if mass is None and name in children and _massless(link):  # the root link is left alone
+            mass = missing_link_mass(robot.urdf.links[name]) if name in robot.urdf.links else FRAME_LINK_MASS
         if mass is None:
             continue
         inertial = link.find("inertial")
@@ -69,6 +75,11 @@ def prepared_urdf(robot: CheckedRobot) -> Path:
         tmp.write_text(text)
         tmp.replace(out)
     return out
+
+
+def _massless(link: ET.Element) -> bool:
+    """No ``<inertial>`` mass (PyBullet would load the link as 1 kg)."""
+    return link.find("inertial/mass") is None
 
 
 def _split_multi_material_visuals(root: ET.Element) -> bool:

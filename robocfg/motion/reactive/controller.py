@@ -38,6 +38,8 @@ from robocfg.collision.shapes import (
 from robocfg.motion.reactive.escape import Blocking, EscapeRule, EscapeSettings
 from robocfg.motion.reactive.limits import step_bounds
 
+CONTINUOUS_RANGE = 1000.0  # rad: limits written on continuous joints for placo (its own joint limits are off)
+
 
 @dataclass(frozen=True)
 class ArmSpec:
@@ -48,8 +50,8 @@ class ArmSpec:
     ee_link: str
     T_ee_tcp: np.ndarray  # 4×4, TCP in the ee_link frame
     base_pose: np.ndarray  # 4×4, world pose of the URDF root link
-    lower: np.ndarray  # rad
-    upper: np.ndarray  # rad
+    lower: np.ndarray  # rad; -inf for a continuous joint
+    upper: np.ndarray  # rad; +inf for a continuous joint
     velocity_limits: np.ndarray  # rad/s
     acceleration_limits: np.ndarray  # rad/s²
     posture: np.ndarray  # rad, the regularisation target (e.g. home)
@@ -89,7 +91,10 @@ class StepResult:
 
 
 def _urdf_without_geometry(path: Path) -> str:
-    """The URDF text without ``<visual>``/``<collision>`` elements (placo then loads no meshes)."""
+    """The URDF text without ``<visual>``/``<collision>`` elements (placo then loads no meshes), and
+    with continuous joints made revolute: pinocchio gives a continuous joint two coordinates
+    (cos, sin), this controller one angle per joint. The angle is left unwrapped (the box bounds of
+    a continuous joint are infinite), so a joint that turns past ±π keeps turning smoothly."""
     import xml.etree.ElementTree as ET
 
     root = ET.parse(path).getroot()
@@ -97,6 +102,14 @@ def _urdf_without_geometry(path: Path) -> str:
         for tag in ("visual", "collision"):
             for el in link.findall(tag):
                 link.remove(el)
+    for joint in root.iter("joint"):
+        if joint.get("type") == "continuous":
+            joint.set("type", "revolute")
+            limit = joint.find("limit")
+            if limit is None:
+                limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
+            limit.set("lower", repr(-CONTINUOUS_RANGE))
+            limit.set("upper", repr(CONTINUOUS_RANGE))
     return ET.tostring(root, encoding="unicode")
 
 

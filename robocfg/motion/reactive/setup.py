@@ -15,7 +15,6 @@ from robocfg.config.commands import FollowObstacle
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body, Scene
 from robocfg.config.types import AXIS_INDEX
-from robocfg.errors import RobocfgError
 from robocfg.geometry import pose_matrix
 from robocfg.motion.reactive.controller import ArmSpec
 
@@ -28,16 +27,14 @@ DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
 def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = None,
              acceleration: float = 10.0, velocity_scale: float = 1.0,
              other_joints: dict[str, float] | None = None) -> ArmSpec:
-    """``ArmSpec`` for ``arm`` of a ``CheckedRobot``: URDF limits (``drives`` overrides), TCP from
+    """``ArmSpec`` for ``arm`` of a ``CheckedRobot``: URDF limits (``drives`` overrides; continuous
+    joints unbounded), TCP from
     ``tcp_offset``/``ee_axis``, posture = home; non-arm joints held at ``other_joints`` (default:
     gripper open, mimic followers following, anything else 0)."""
     cfg = robot.config
     arm_cfg = cfg.arm(arm)
     names = robot.arm_joints(arm_cfg)
     urdf = robot.urdf
-    for n in names:
-        if urdf.joints[n].type == "continuous":
-            raise RobocfgError(f"follow-target does not support continuous joint {n!r} yet (give it limits in the URDF)")
     vel = np.array([cfg.drives.velocity_limits.get(n) or urdf.joints[n].velocity or DEFAULT_VELOCITY for n in names])
     acc = np.array([cfg.drives.acceleration_limits.get(n, acceleration) for n in names])
     T_ee_tcp = np.eye(4)
@@ -53,7 +50,8 @@ def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: s
     return ArmSpec(
         urdf_path=Path(urdf_path), joint_names=names, ee_link=arm_cfg.ee_link, T_ee_tcp=T_ee_tcp,
         base_pose=np.asarray(base_pose, float),
-        lower=np.array([urdf.joints[n].lower for n in names]), upper=np.array([urdf.joints[n].upper for n in names]),
+        lower=np.array([-np.inf if urdf.joints[n].type == "continuous" else urdf.joints[n].lower for n in names]),
+        upper=np.array([np.inf if urdf.joints[n].type == "continuous" else urdf.joints[n].upper for n in names]),
         velocity_limits=vel * velocity_scale, acceleration_limits=acc,
         posture=np.asarray(arm_cfg.home, float), other_joints=held, collision=collision,
     )
