@@ -68,3 +68,55 @@ def test_arm_without_gripper_and_a_relative_urdf(tmp_path):
     lo = [robot.urdf.joints[j].lower for j in robot.config.arms[0].joints]
     hi = [robot.urdf.joints[j].upper for j in robot.config.arms[0].joints]
     assert all(a <= h <= b for a, h, b in zip(lo, robot.config.arms[0].home, hi, strict=True))
+
+
+def test_composed_robot_draft_reproduces_the_shipped_tcp(tmp_path, capsys, monkeypatch):
+    """`new-robot` on urdf + attachments (the UR5e + Robotiq 2F-85 of the library): the TCP point
+    (tool0 frame, by FK at home) lies within 2 mm of the shipped YAML's, and the home found by IK
+    points the tool straight down."""
+    parts = tmp_path / "parts.yaml"
+    parts.write_text("urdf: airo_models://ur5e\nattachments:\n  - urdf: airo_models://robotiq_2f_85\n    mount_link: tool0\n")
+    code, out, _ = run_main(["new-robot", str(parts), "-o", str(tmp_path / "ur5e_2f85.yaml")], capsys, monkeypatch, tmp_path)
+    assert code == 0, out
+    assert "gripper parallel ['finger_joint']" in out
+    draft = load_robot(tmp_path / "ur5e_2f85.yaml")
+    shipped = load_robot(ROOT / "robots" / "ur5e_robotiq_2f85.yaml")
+    assert draft.config.attachments[0].urdf == "airo_models://robotiq_2f_85" and draft.config.urdf == "airo_models://ur5e"
+    got, want = draft.config.arms[0], shipped.config.arms[0]
+
+    def tcp_in_tool0(robot, arm) -> np.ndarray:
+        T = np.linalg.inv(robot.urdf.link_pose("tool0")) @ robot.urdf.link_pose(arm.ee_link)
+        axis = "xyz".index(arm.ee_axis)
+        return T[:3, 3] + arm.tcp_offset * T[:3, axis]
+
+    assert np.linalg.norm(tcp_in_tool0(draft, got) - tcp_in_tool0(shipped, want)) < 0.002
+    q = dict(zip(got.joints, got.home, strict=True))
+    tool_z = (draft.urdf.link_pose(got.ee_link, q))[:3, "xyz".index(got.ee_axis)]
+    assert tool_z[2] < -0.999  # approach axis straight down
+    assert all(n in draft.config.physics.link_masses for n in ("left_inner_finger_pad", "robotiq_2f_85_base_link", "tool0"))
+
+
+def test_one_jaw_gripper_is_detected_not_taken_for_an_arm_joint(tmp_path):
+    d = draft_robot(parse_urdf(ROOT / "tests" / "data" / "sim_onejaw.urdf"), "onejaw", tmp_path)
+    assert d.arm_joints == ["j1", "j2", "j3", "j4", "j5", "j6"]
+    g = d.gripper
+    assert g.kind == "one_jaw" and g.joints == ["jaw"] and g.finger_links == ["moving_jaw", "fixed_jaw"]
+    assert g.fixed_jaw_face == pytest.approx(0.02, abs=1e-4) and g.max_width == pytest.approx(0.08, abs=1e-4)
+    assert d.tcp_offset == pytest.approx(0.09, abs=1e-4) and d.ee_axis == "z"
+    assert d.link_masses == {"tool0": 0.001}
+    out = tmp_path / "onejaw.yaml"
+    out.write_text(render_yaml(d))
+    assert load_robot(out).warnings == []
+
+
+def test_drafted_panda_runs_gripper_and_pick_place(tmp_path, capsys, monkeypatch):
+    code, out, _ = run_main(["new-robot", str(PANDA_URDF), "-o", str(tmp_path / "p.yaml")], capsys, monkeypatch, tmp_path)
+    assert code == 0, out
+    code, _, err = run_main(["run", "gripper", "--robot", str(tmp_path / "p.yaml"), "-q"], capsys, monkeypatch, tmp_path)
+    assert code == 0, err
+    code, _, err = run_main(["run", "pick-place", "--robot", str(tmp_path / "p.yaml"), "--episodes", "2", "--json",
+                             str(tmp_path / "r.json"), "-q"], capsys, monkeypatch, tmp_path)
+    assert code == 0, err
+    import json
+
+    assert json.loads((tmp_path / "r.json").read_text())["summary"]["success_rate"] == 1.0

@@ -2,23 +2,22 @@
 
 Everything is derived from the URDF's structure and geometry, never from names:
 
-* **arm** — the longest serial chain of non-mimic movable joints (:func:`longest_serial_chain`);
-  ``base_link`` is the parent link of its first joint;
-* **gripper** — the non-mimic movable joints below the arm (leaders); their ``<mimic>`` followers
-  are left to the URDF; ``open``/``closed`` are the leader limits with the wider/narrower gap;
+* **arm** — the longest serial chain of non-mimic movable joints (:func:`longest_serial_chain`),
+  less a one-jaw gripper's jaw at its end; ``base_link`` is the parent link of its first joint;
+* **gripper, ee_axis, tcp_offset, fingers** — :mod:`robocfg.assets.draft_gripper` (parallel,
+  one-jaw, or the tip of a tool), measured exactly as ``robocfg validate`` measures them;
 * **ee_link** — among the links rigidly attached to the last arm joint (:func:`ee_candidates`),
   the one the gripper hangs from (else the deepest one);
-* **fingers** — of the leaf links the gripper joints move, the one reaching furthest along the
-  approach axis and the furthest-reaching one on the other side of it;
-* **ee_axis / tcp_offset** — the ``ee_link`` axis pointing at the finger-pad midpoint (gripper
-  open) and the distance along it, measured exactly as ``robocfg validate`` measures it (the
-  distal ``PAD_LENGTH`` of each finger's geometry);
 * **R_ee_graspnet** — rows are the grasp axes in the ``ee_link`` frame: x = approach
-  (``+ee_axis``), y = the ``+`` ee axis closest to the pad-to-pad line (finger closing axis),
-  z = x × y;
-* **home** — 0 where 0 is well inside a joint's limits (10 % of the range), else mid-limits.
+  (``+ee_axis``), y = the ee axis of the finger closing direction, z = x × y;
+* **home** — here 0 where 0 is well inside a joint's limits (10 % of the range), else
+  mid-limits; the CLI then replaces it by an IK pose with the tool pointing down over the
+  workspace (``robocfg.kinematics.home``), which needs the drafted file to load;
+* **link_masses** — every link without ``<inertial>`` (PyBullet would load it as 1 kg).
 
-Frames: all geometry in the ``ee_link`` frame, metres. No printing here: the CLI reports the notes.
+A composed robot (``urdf`` + ``attachments``) is drafted from its composed URDF and written with
+its own ``urdf`` and ``attachments``. Frames: geometry in the ``ee_link`` frame, metres. No
+printing here: the CLI reports the notes.
 """
 
 from __future__ import annotations
@@ -30,30 +29,33 @@ from pathlib import Path
 
 import numpy as np
 
+from robocfg.assets.draft_gripper import (
+    GripperDraft,
+    UnsupportedGripper,
+    one_jaw_gripper,
+    parallel_gripper,
+    tool_tip,
+)
 from robocfg.assets.inspection import ee_candidates, longest_serial_chain
-from robocfg.assets.meshes import geometry_points
-from robocfg.assets.paths import Resolver, UnresolvedPath, _package_root
-from robocfg.assets.urdf import Urdf
+from robocfg.assets.paths import Resolver, _package_root
+from robocfg.assets.urdf import Urdf, missing_link_mass
+from robocfg.config.robot import RobotSource
 
-PAD_LENGTH = 0.02  # m: the distal part of a finger counted as its pad (as robocfg validate does)
 HOME_MARGIN = 0.1  # fraction of a joint's range: 0 closer than this to a limit is not used as home
-MIN_FINGER_SEPARATION = 0.005  # m: two pads closer than this across the approach axis are one side
 AXES = "xyz"
 URI_ROOTS = (("pybullet_data://", "pybullet_data"), ("airo_models://", "airo_models"))
 
 
 @dataclass
-class GripperDraft:
-    """A parallel gripper found in the URDF (leader joints and the finger geometry)."""
+class AttachmentDraft:
+    """An attachment copied into the draft (``urdf`` already relative to the output folder)."""
 
-    joints: list[str]
-    open: list[float]
-    closed: list[float]
-    finger_links: list[str]
-    max_width: float  # m, pad-face gap when open
-    min_width: float  # m, pad-face gap when closed
-    max_force: float
-    closing_axis: str  # +ee axis closest to the pad-to-pad line
+    urdf: str
+    mount_link: str
+    mount_xyz: list[float]
+    mount_rpy_deg: list[float]
+    name: str | None = None
+    prefix: str | None = None
 
 
 @dataclass
@@ -71,49 +73,109 @@ class RobotDraft:
     R_ee_graspnet: list[list[float]]
     home: list[float]
     gripper: GripperDraft | None
-    massless: list[str] = field(default_factory=list)  # moving links without <inertial>
+    link_masses: dict[str, float] = field(default_factory=dict)  # links without <inertial> → kg
     notes: list[str] = field(default_factory=list)
+    attachments: list[AttachmentDraft] = field(default_factory=list)
+    package_dirs: dict[str, str] = field(default_factory=dict)
+    suction_link: str | None = None  # the tool link whose tip is the TCP, when there is no gripper
+    home_found: bool = False  # True once the home comes from IK (tool down over the workspace)
 
 
-def draft_robot(urdf: Urdf, name: str, out_dir: Path) -> RobotDraft:
+def draft_robot(urdf: Urdf, name: str, out_dir: Path, urdf_uri: str | None = None) -> RobotDraft:
     """Derive a robot draft from a parsed URDF; ``out_dir`` is where the YAML will live (for the
-    relative URDF path)."""
+    relative URDF path). ``urdf_uri`` overrides the URDF reference written (a composed robot
+    refers to its own ``urdf`` and ``attachments``, not the composed file)."""
     notes: list[str] = []
     chain = longest_serial_chain(urdf)
     if not chain:
         raise ValueError(f"{urdf.path}: no movable joints, nothing to drive")
+    resolver = Resolver(urdf.path.parent)
+    found = None
+    if len(chain) > 1:  # a jaw at the end of the serial chain (one-jaw gripper) is not an arm joint
+        found = one_jaw_gripper(urdf, resolver, chain, urdf.joints[chain[-1]].parent)
+        if found is not None:
+            notes.append(f"one-jaw gripper: {chain[-1]!r} moves {found.gripper.finger_links[0]!r} against the fixed jaw "
+                         f"{found.gripper.finger_links[1]!r}")
+            chain = chain[:-1]
     base_link = urdf.joints[chain[0]].parent
     cands = ee_candidates(urdf, chain)
     below = urdf.descendants(chain[-1])
     leaders = [j.name for j in urdf.joints.values()
                if j.movable and j.mimic is None and j.name not in chain and j.parent in below]
-    resolver = Resolver(urdf.path.parent)
-    ee_link = _pick_ee_link(urdf, cands, leaders)
-    gripper, ee_axis, tcp = None, "z", 0.1
-    if leaders:
-        found = _gripper(urdf, resolver, ee_link, leaders, notes)
-        if found is not None:
-            gripper, ee_axis, tcp = found
-    else:
-        notes.append("no gripper joints below the arm: add a `gripper:` block (suction: `type: suction` with the cup "
-                     "link) and set ee_axis/tcp_offset to the tool's working point")
-    R = _r_ee_graspnet(ee_axis, gripper.closing_axis if gripper else _other_axis(ee_axis))
+    ee_link = urdf.joints[found.gripper.joints[0]].parent if found is not None else _pick_ee_link(urdf, cands, leaders)
+    suction_link = None
+    if found is None and leaders:
+        try:
+            found = parallel_gripper(urdf, resolver, ee_link, leaders)
+        except UnsupportedGripper as exc:
+            notes.append(f"unsupported gripper: {exc}; write the gripper block by hand (type parallel, one_jaw or suction)")
+    if found is None:
+        tip = tool_tip(urdf, resolver, ee_link, cands)
+        if not leaders:
+            notes.append("no gripper joints below the arm: for a suction tool add `gripper: {type: suction, link: ...}` "
+                         "(the draft names the tool link in a comment); tcp_offset is the tip of the tool's geometry "
+                         "(a suction cup's face)")
+        if tip is not None:
+            found, suction_link = tip
+        else:
+            from robocfg.assets.draft_gripper import GripperGeometry
+
+            found = GripperGeometry(None, "z", 0.1)
+            notes.append("no tool geometry: ee_axis z and tcp_offset 0.1 are placeholders")
+    gripper, ee_axis, tcp = found.gripper, found.ee_axis, found.tcp_offset
+    if tcp <= 0:
+        notes.append(f"the tool lies on the negative side of every axis of {ee_link!r}: pick an ee_link whose "
+                     "+x, +y or +z points at the fingertips")
+        tcp = 0.1
+    if gripper is not None:
+        notes.append(f"gripper max_force {gripper.max_force:g} is the URDF effort limit of {gripper.joints}: check it "
+                     "against the object (too much torque tilts linkage fingers)")
+        notes.append(f"tcp_offset {tcp:.4f} m is the finger-pad midpoint with the gripper closed (as validate measures it); "
+                     "grasp a test object and adjust")
+    closing_sign = gripper.closing_sign if gripper else 1.0
+    R = _r_ee_graspnet(ee_axis, gripper.closing_axis if gripper else _other_axis(ee_axis), closing_sign)
     home = []
     for jn in chain:
         j = urdf.joints[jn]
         lo, hi = (j.lower, j.upper) if j.type != "continuous" else (-math.pi, math.pi)
         margin = HOME_MARGIN * (hi - lo)
         home.append(0.0 if lo + margin <= 0.0 <= hi - margin else round((lo + hi) / 2, 4))
-    notes.append("home: 0 or mid-limits per joint — pick a pose that is clear of the table with the tool pointing down")
     notes.append("drives (stiffness, damping, max_force) are defaults for a small arm — raise max_force for a heavy one")
     if len(cands) > 1:
         notes.append(f"ee_link {ee_link!r} chosen among {cands}")
-    massless = sorted({j.child for j in urdf.joints.values() if j.movable}
-                      - {ln.name for ln in urdf.links.values() if ln.mass is not None and ln.mass > 0})
-    if massless:
-        notes.append(f"moving links without <inertial> get 0.01 kg in physics.link_masses: {massless}")
-    return RobotDraft(name, _uri(urdf.path, out_dir), chain, base_link, ee_link, cands, ee_axis, round(tcp, 4), R,
-                      home, gripper, massless, notes)
+    masses = {j.child: missing_link_mass(urdf.links[j.child]) for j in urdf.joints.values()
+              if j.child in urdf.links and urdf.links[j.child].mass is None}
+    if masses:
+        notes.append(f"links without <inertial> get small masses in physics.link_masses (0.01 kg with geometry, "
+                     f"0.001 kg for frames): {sorted(masses)}")
+    return RobotDraft(name, urdf_uri or _uri(urdf.path, out_dir), chain, base_link, ee_link, cands, ee_axis, round(tcp, 4), R,
+                      home, gripper, masses, notes, suction_link=suction_link)
+
+
+def draft_composed(source: Path, src: RobotSource, name: str, out_dir: Path) -> RobotDraft:
+    """Draft a robot given as ``urdf`` + ``attachments`` (a ``RobotSource`` read from ``source``):
+    the geometry comes from the composed URDF, the draft keeps the parts (paths rebased on
+    ``out_dir``). Raises UnresolvedPath or CompositionError for missing or clashing parts."""
+    from robocfg.assets.compose import Part, compose, rpy_from_deg
+    from robocfg.assets.urdf import parse_urdf
+
+    resolver = Resolver(source.parent, src.package_dirs)
+    base = resolver.urdf(src.urdf)
+    parts = [Part(resolver.urdf(a.urdf), a.mount_link, tuple(a.mount_xyz), rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix)
+             for a in src.attachments]
+    composed = compose(base, parts, resolver).path
+    d = draft_robot(parse_urdf(composed), name, out_dir, urdf_uri=_rebase(src.urdf, source.parent, out_dir))
+    d.attachments = [AttachmentDraft(_rebase(a.urdf, source.parent, out_dir), a.mount_link, list(a.mount_xyz),
+                                     list(a.mount_rpy_deg), a.name, a.prefix) for a in src.attachments]
+    d.package_dirs = {k: _rebase(v, source.parent, out_dir) for k, v in src.package_dirs.items()}
+    return d
+
+
+def _rebase(ref: str, src_dir: Path, out_dir: Path) -> str:
+    """A path written relative to ``src_dir``, rewritten relative to ``out_dir`` (URIs unchanged)."""
+    if "://" in ref or Path(ref).is_absolute():
+        return ref
+    return Path(os.path.relpath((src_dir / ref).resolve(), out_dir.resolve())).as_posix()
 
 
 def _pick_ee_link(urdf: Urdf, cands: list[str], leaders: list[str]) -> str:
@@ -125,118 +187,14 @@ def _pick_ee_link(urdf: Urdf, cands: list[str], leaders: list[str]) -> str:
     return max(cands, key=lambda ln: len(urdf.chain(urdf.root, ln) or []))
 
 
-def _finger_pad(urdf: Urdf, resolver: Resolver, link: str, T_ee_inv: np.ndarray, q: dict[str, float]) -> np.ndarray | None:
-    """(N, 3) geometry points of ``link`` in the ee_link frame, or None without geometry."""
-    geoms = urdf.links[link].collisions or urdf.links[link].visuals
-    pts = []
-    for g in geoms:
-        mesh = None
-        if g.kind == "mesh":
-            try:
-                mesh = resolver.mesh(g.filename or "", urdf.path)
-            except UnresolvedPath:
-                continue
-        pts.append(geometry_points(g, mesh))
-    if not pts or not len(np.concatenate(pts)):
-        return None
-    T = T_ee_inv @ urdf.link_pose(link, q)
-    return np.concatenate(pts) @ T[:3, :3].T + T[:3, 3]
-
-
-def _pad_center(P: np.ndarray, axis: int) -> np.ndarray:
-    tip = P[:, axis].max()
-    pad = P[P[:, axis] >= tip - PAD_LENGTH]
-    return (pad.min(axis=0) + pad.max(axis=0)) / 2
-
-
-def _gripper(urdf: Urdf, resolver: Resolver, ee_link: str, leaders: list[str],
-             notes: list[str]) -> tuple[GripperDraft, str, float] | None:
-    followers = [j.name for j in urdf.joints.values() if j.mimic is not None and j.mimic.joint in leaders]
-    moved = set().union(*(urdf.descendants(j) for j in leaders + followers))
-    leaves = sorted(ln for ln in moved if not any(j.parent == ln for j in urdf.joints.values()))
-    lo = {j: urdf.joints[j].lower for j in leaders}
-    hi = {j: urdf.joints[j].upper for j in leaders}
-
-    def clouds(q: dict[str, float]) -> dict[str, np.ndarray]:
-        T_inv = np.linalg.inv(urdf.link_pose(ee_link, q))
-        out = {}
-        for ln in leaves:
-            P = _finger_pad(urdf, resolver, ln, T_inv, q)
-            if P is not None:
-                out[ln] = P
-        return out
-
-    c_lo, c_hi = clouds(lo), clouds(hi)
-    if len(c_lo) < 2:
-        notes.append(f"gripper joints {leaders} move fewer than two links with geometry: fill in the gripper block by hand")
-        return None
-    centroid = np.concatenate(list(c_lo.values())).mean(axis=0)
-    axis = int(np.argmax(centroid))
-    if centroid[axis] <= 0:
-        notes.append(f"the fingers lie on the negative side of every axis of {ee_link!r}: pick an ee_link whose "
-                     "+x, +y or +z points at the fingertips")
-    # Opening: the leader limit with the wider pad gap.
-    pair_lo = _finger_pair(c_lo, axis)
-    gap_lo = _gap(c_lo, pair_lo, axis)
-    gap_hi = _gap(c_hi, pair_lo, axis) if all(f in c_hi for f in pair_lo) else 0.0
-    open_q, closed_q, clouds_open = (hi, lo, c_hi) if gap_hi > gap_lo else (lo, hi, c_lo)
-    pair = _finger_pair(clouds_open, axis)
-    a, b = (_pad_center(clouds_open[f], axis) for f in pair)
-    tcp = float((a[axis] + b[axis]) / 2)
-    d = b - a
-    d[axis] = 0.0
-    closing = AXES[int(np.argmax(np.abs(d)))]
-    if closing == AXES[axis]:
-        closing = _other_axis(AXES[axis])
-    width_open, width_closed = max(gap_lo, gap_hi), min(gap_lo, gap_hi)
-    efforts = [urdf.joints[j].effort for j in leaders]
-    force = float(min(e for e in efforts if e > 0)) if any(e > 0 for e in efforts) else 40.0
-    notes.append(f"gripper max_force {force:g} is the URDF effort limit of {leaders}: check it against the object "
-                 "(too much torque tilts linkage fingers)")
-    notes.append(f"tcp_offset {tcp:.4f} m is the finger-pad midpoint with the gripper open; grasp a test object and adjust")
-    g = GripperDraft(leaders, [round(open_q[j], 6) for j in leaders], [round(closed_q[j], 6) for j in leaders],
-                     list(pair), round(max(width_open, 1e-3), 4), round(max(width_closed, 0.0), 4), force, closing)
-    return g, AXES[axis], tcp
-
-
-def _finger_pair(clouds: dict[str, np.ndarray], axis: int) -> tuple[str, str]:
-    """The link reaching furthest along ``axis`` and the furthest-reaching one across from it."""
-    tips = sorted(clouds, key=lambda ln: -clouds[ln][:, axis].max())
-    first = tips[0]
-    ca = _pad_center(clouds[first], axis)
-    for other in tips[1:]:
-        d = _pad_center(clouds[other], axis) - ca
-        d[axis] = 0.0
-        if np.linalg.norm(d) > MIN_FINGER_SEPARATION:
-            return first, other
-    return first, tips[1]
-
-
-def _gap(clouds: dict[str, np.ndarray], pair: tuple[str, str], axis: int) -> float:
-    """Gap (m) between the two pads' facing sides, along the pad-to-pad line."""
-    a, b = (_pad_center(clouds[f], axis) for f in pair)
-    d = b - a
-    d[axis] = 0.0
-    n = np.linalg.norm(d)
-    if n < 1e-9:
-        return 0.0
-    u = d / n
-
-    def pad(f: str) -> np.ndarray:
-        P = clouds[f]
-        return P[P[:, axis] >= P[:, axis].max() - PAD_LENGTH]
-
-    return float(max(0.0, (pad(pair[1]) @ u).min() - (pad(pair[0]) @ u).max()))
-
-
 def _other_axis(axis: str) -> str:
     return "y" if axis != "y" else "z"
 
 
-def _r_ee_graspnet(ee_axis: str, closing: str) -> list[list[float]]:
-    """Rows: grasp x (approach = +ee_axis), y (closing = +closing axis), z = x × y, in ee coordinates."""
+def _r_ee_graspnet(ee_axis: str, closing: str, sign: float = 1.0) -> list[list[float]]:
+    """Rows: grasp x (approach = +ee_axis), y (closing = sign · closing axis), z = x × y, in ee coordinates."""
     x = np.eye(3)[AXES.index(ee_axis)]
-    y = np.eye(3)[AXES.index(closing)]
+    y = sign * np.eye(3)[AXES.index(closing)]
     R = np.vstack([x, y, np.cross(x, y)])
     return [[float(v) + 0.0 for v in row] for row in R]
 
@@ -265,6 +223,22 @@ def render_yaml(d: RobotDraft) -> str:
         f"name: {d.name}",
         f"description: {d.name} (drafted by robocfg new-robot from its URDF)",
         f"urdf: {d.urdf_uri}",
+    ]
+    if d.package_dirs:
+        lines += ["package_dirs:"] + [f"  {k}: {v}" for k, v in d.package_dirs.items()]
+    if d.attachments:
+        lines.append("attachments:")
+        for a in d.attachments:
+            lines += [f"  - urdf: {a.urdf}", f"    mount_link: {a.mount_link}", f"    mount_xyz: {vec(a.mount_xyz)}",
+                      f"    mount_rpy_deg: {vec(a.mount_rpy_deg)}"]
+            lines += [f"    name: {a.name}"] if a.name else []
+            lines += [f"    prefix: '{a.prefix}'"] if a.prefix is not None else []
+    g = d.gripper
+    tcp_note = ("finger-pad midpoint with the gripper closed" if g is not None
+                else "tip of the tool's geometry (a suction cup's face)")
+    home_note = ("IK pose: tool pointing down over the workspace in front of the robot" if d.home_found
+                 else "CHECK: 0 or mid-limits. Choose a pose clear of the table, tool down")
+    lines += [
         "fixed_base: true",
         "arms:",
         "  - name: arm",
@@ -273,22 +247,21 @@ def render_yaml(d: RobotDraft) -> str:
         f"    base_link: {d.base_link}",
         f"    # CHECK: links rigidly attached to the last arm joint: {', '.join(d.ee_candidates)}",
         f"    ee_link: {d.ee_link}",
-        "    # CHECK: finger-pad midpoint (gripper open) along ee_axis, measured from the finger geometry.",
+        f"    # CHECK: {tcp_note}, along ee_axis, measured as robocfg validate measures it.",
         f"    tcp_offset: {_num(d.tcp_offset)}",
         f"    ee_axis: {d.ee_axis}",
         f"    # Grasp x (approach) = ee +{d.ee_axis}"
-        + (f", y (closing) = ee +{d.gripper.closing_axis}" if d.gripper else " (no gripper found: CHECK the rest)")
+        + (f", y (closing) = ee {'+' if g.closing_sign > 0 else '-'}{g.closing_axis}" if g else " (no gripper found: CHECK the rest)")
         + ", z = x × y.",
         f"    R_ee_graspnet: [{', '.join(vec(r) for r in d.R_ee_graspnet)}]",
-        "    # CHECK: 0 where allowed, else mid-limits. Choose a pose clear of the table, tool down.",
+        f"    # {home_note}.",
         f"    home: {vec(d.home)}",
         f"    home_std: {vec([0.05] * len(d.home))}",
     ]
-    g = d.gripper
     if g is not None:
         lines += [
             "    gripper:",
-            "      type: parallel",
+            f"      type: {g.kind}",
             "      # Driven (leader) joints; their <mimic> followers are coupled from the URDF.",
             f"      joints: [{', '.join(g.joints)}]",
             f"      open: {vec(g.open)}",
@@ -297,6 +270,11 @@ def render_yaml(d: RobotDraft) -> str:
             f"      max_width: {_num(g.max_width)}",
             f"      min_width: {_num(g.min_width)}",
             f"      finger_links: [{', '.join(g.finger_links)}]",
+        ]
+        if g.fixed_jaw_face is not None:
+            lines += ["      # The fixed jaw's inner face across the ee_axis line, along the closing direction (m).",
+                      f"      fixed_jaw_face: {_num(g.fixed_jaw_face)}"]
+        lines += [
             "      # CHECK: the URDF effort limit; linkage grippers often need much less.",
             f"      max_force: {_num(g.max_force)}",
             "      lateral_friction: 1.0",
@@ -305,7 +283,7 @@ def render_yaml(d: RobotDraft) -> str:
         ]
     else:
         lines += ["    # CHECK: no gripper joints found. For a suction cup:",
-                  "    # gripper: {type: suction, link: CUP_LINK, hold_force: 50.0}"]
+                  f"    # gripper: {{type: suction, link: {d.suction_link or 'CUP_LINK'}, hold_force: 50.0}}"]
     lines += [
         "drives:",
         "  # CHECK: PyBullet position-drive gains; raise max_force (N·m) for heavy arms.",
@@ -314,9 +292,10 @@ def render_yaml(d: RobotDraft) -> str:
         "  solver_iterations: 150",
         "  self_collision: true",
     ]
-    if d.massless:
-        lines += ["  # CHECK: these moving links have no <inertial> (PyBullet would make each 1 kg).",
-                  "  link_masses:"] + [f"    {ln}: 0.01" for ln in d.massless]
+    if d.link_masses:
+        lines += ["  # CHECK: these links have no <inertial> (PyBullet would make each 1 kg): 0.01 kg with geometry,",
+                  "  # 0.001 kg for bare frames.",
+                  "  link_masses:"] + [f"    {ln}: {_num(m)}" for ln, m in sorted(d.link_masses.items())]
     lines.append("ik_backend: lm")
     return "\n".join(lines) + "\n"
 

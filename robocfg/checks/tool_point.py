@@ -84,3 +84,45 @@ def check_suction(warn: Warn, urdf: Urdf, resolver: Resolver, arm: ArmConfig, g:
     elif abs(face - arm.tcp_offset) > CUP_WARN_DIST:
         warn(tcp_loc, f"the TCP of a suction gripper is the cup face, measured at {face:.4f} m along {arm.ee_axis} "
              f"of {arm.ee_link}; tcp_offset is {arm.tcp_offset:.4f} m")
+
+
+HINT_TCP_DIST = 0.003  # m: a tcp_offset this far from the closed pad midpoint is named as the likely cause
+NOTHING_GAP = 0.002  # m: fingers within this of min_width closed on nothing
+
+
+def pad_midpoints(urdf: Urdf, resolver: Resolver, arm: ArmConfig, leaders: list[str]) -> tuple[float, float] | None:
+    """(open, closed) distance (m) of the finger-pad midpoint along ``ee_axis`` — what ``validate``
+    measures — or None without a finger gripper or finger geometry."""
+    from robocfg.config.robot import ParallelGripperConfig
+
+    g = arm.gripper
+    if not isinstance(g, ParallelGripperConfig):
+        return None
+    axis = AXIS_INDEX[arm.ee_axis]
+    links = list(g.finger_links)
+    try:
+        pts = finger_points(urdf, resolver, links)
+    except FingerGeometryMissing:
+        return None
+    from robocfg.assets.fingers import pad_midpoint
+
+    o, c = (float(pad_midpoint(pad_points(urdf, arm.ee_link, links, pts, dict(zip(leaders, q, strict=True)), axis))[axis])
+            for q in (g.open, g.closed))
+    return o, c
+
+
+def grasp_failure_hint(urdf: Urdf, resolver: Resolver, arm: ArmConfig, leaders: list[str], width: float | None) -> str:
+    """The likely cause of a grasp that did not hold, for the failure message: the fingers closed
+    on nothing (``width`` at the closed gap) or the object slipped, and — when ``tcp_offset`` is
+    off the closed pad midpoint — ``check tcp_offset (now 0.130 m, pads measured at 0.144 m closed)``."""
+    from robocfg.config.robot import ParallelGripperConfig
+
+    g = arm.gripper
+    if not isinstance(g, ParallelGripperConfig):
+        return ""
+    what = "fingers closed on nothing" if width is not None and width <= g.min_width + NOTHING_GAP else "object slipped"
+    mids = pad_midpoints(urdf, resolver, arm, leaders)
+    if mids is not None and abs(mids[1] - arm.tcp_offset) > HINT_TCP_DIST:
+        return (f"{what}: check tcp_offset (now {arm.tcp_offset:.3f} m, pads measured at {mids[1]:.3f} m closed"
+                + (f", {mids[0]:.3f} m open)" if abs(mids[0] - mids[1]) > 1e-3 else ")"))
+    return f"{what}: check the grip force (gripper.max_force {g.max_force:g}), the friction and the object's width"

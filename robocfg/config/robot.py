@@ -248,3 +248,12 @@ class RobotConfig(Frozen):
         from robocfg.errors import NotFound
 
         raise NotFound("arm", name, [a.name for a in self.arms])
+
+
+class RobotSource(Frozen):
+    """What ``robocfg new-robot`` drafts from when given a YAML file instead of a URDF: a robot
+    composed of a URDF and its attachments (e.g. an arm and a gripper from two packages)."""
+
+    urdf: str = Field(description="Path relative to this YAML, or pybullet_data://, airo_models://, package://.")
+    package_dirs: dict[str, str] = Field(default_factory=dict, description="package:// name → directory.")
+    attachments: list[Attachment] = Field(default_factory=list, description="URDFs welded onto the robot, in order.")

@@ -21,9 +21,10 @@ from typing import Any
 import yaml
 
 from robocfg.assets.compose import CompositionError, Part, compose, rpy_from_deg
-from robocfg.assets.draft import _gripper, _uri
+from robocfg.assets.draft import _uri
+from robocfg.assets.draft_gripper import UnsupportedGripper, parallel_gripper
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import Urdf, UrdfParseError, parse_urdf
+from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass, parse_urdf
 from robocfg.checks import CheckedRobot, load_robot
 from robocfg.config.load import (
     _MISSING,
@@ -92,6 +93,7 @@ def import_interndata(their_path: Path, output: Path, urdf: str | None = None) -
     robot = overlay({**robot, **mapped.robot}, block)
     notes = list(mapped.notes)
     _fill_grippers(robot, mapped, parsed, notes)
+    _fill_masses(robot, parsed, notes)
     checked, warnings = _validate(doc, robot, mapped, block, output)
     return ImportResult(output, checked, dropped + mapped.dropped, notes, mapped.warnings + warnings)
 
@@ -130,12 +132,15 @@ def _fill_grippers(robot: dict[str, Any], mapped: Mapped, urdf: Urdf, notes: lis
         need = [k for k in ("open", "closed", "finger_links", "max_width") if k not in g]
         if not need or arm.get("ee_link") not in urdf.links:
             continue
-        found = _gripper(urdf, Resolver(urdf.path.parent), arm["ee_link"], mapped.leaders.get(i) or list(g["joints"]), [])
-        if found is None:
+        try:
+            found = parallel_gripper(urdf, Resolver(urdf.path.parent), arm["ee_link"], mapped.leaders.get(i) or list(g["joints"]))
+        except UnsupportedGripper:
+            found = None
+        if found is None or found.gripper is None:
             notes.append(f"arms[{i}].gripper: the finger links could not be found from the URDF geometry; add them "
                          f"under '{BLOCK_KEY}: arms: [{{gripper: {{finger_links: [A, B]}}}}]' in the input")
             continue
-        draft = found[0]
+        draft = found.gripper
         if "open" in g and "closed" in need:
             # The closed position is the joint limit farther from the open one.
             g["closed"] = [_far_limit(urdf, j, q) for j, q in zip(draft.joints, g["open"], strict=True)]
@@ -145,6 +150,18 @@ def _fill_grippers(robot: dict[str, Any], mapped: Mapped, urdf: Urdf, notes: lis
             g.setdefault("min_width", draft.min_width)
         notes.append(f"arms[{i}].gripper: {', '.join(need)} derived from the URDF (joint limits, finger geometry) "
                      f"— finger_links {g['finger_links']}, closed {g['closed']}")
+
+
+def _fill_masses(robot: dict[str, Any], urdf: Urdf, notes: list[str]) -> None:
+    """Small masses for the links without ``<inertial>`` (PyBullet would load each as 1 kg), as
+    ``robocfg new-robot`` writes them; masses the input gives are kept."""
+    physics = robot.setdefault("physics", {})
+    given = physics.get("link_masses") or {}
+    extra = {j.child: missing_link_mass(urdf.links[j.child]) for j in urdf.joints.values()
+             if j.child in urdf.links and urdf.links[j.child].mass is None and j.child not in given}
+    if extra:
+        physics["link_masses"] = {**given, **extra}
+        notes.append(f"physics.link_masses: links without <inertial> get 0.01 kg (with geometry) or 0.001 kg: {sorted(extra)}")
 
 
 def _far_limit(urdf: Urdf, joint: str, q: float) -> float:

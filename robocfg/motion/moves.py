@@ -48,6 +48,18 @@ def bound_ik_by_iterations(model: KinematicModel, iterations: int = IK_ITERATION
 MoveFailed = PhaseFailed  # the name the motion code raises; one (phase, reason) error for all
 
 
+def grasp_hint(arm: ArmHandle, width: float | None) -> str:
+    """The likely cause of a grasp that does not hold, for a failure message ("" when none can be
+    named): fingers closed on nothing or the object slipped, and ``tcp_offset`` against the finger
+    pads measured from the URDF (``robocfg.checks.tool_point.grasp_failure_hint``)."""
+    from robocfg.assets.paths import Resolver
+    from robocfg.checks.tool_point import grasp_failure_hint
+
+    checked = arm.robot.checked
+    return grasp_failure_hint(checked.urdf, Resolver(checked.path.parent, checked.config.package_dirs), arm.config,
+                              checked.gripper_joints(arm.config), width)
+
+
 @dataclass
 class ArmMover:
     """Moves one arm of ``world``. ``model``: KinematicModel of the arm; ``limits``: JointLimits
@@ -187,7 +199,8 @@ class ArmMover:
                 if g.is_grasping(body):
                     return
                 width = f" (width {w * 1000:.1f} mm)" if w is not None else ""
-                raise MoveFailed(self.phase, f"the object is not held{width}")
+                hint = grasp_hint(self.arm, w)
+                raise MoveFailed(self.phase, f"the object is not held{width}" + (f"; {hint}" if hint else ""))
 
     def _gripper(self) -> Gripper:
         if self.arm.gripper is None:

@@ -23,7 +23,7 @@ from robocfg.config.commands import PickPlaceParams
 from robocfg.config.scene import Body
 from robocfg.geometry import rotation_angle
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, top_down_grasps
-from robocfg.motion.moves import ArmMover, MoveFailed
+from robocfg.motion.moves import ArmMover, MoveFailed, grasp_hint
 from robocfg.runners.pick_place_report import EpisodeResult, PhaseRecord
 
 if TYPE_CHECKING:
@@ -210,7 +210,9 @@ class _StateMachine:
         want = 0.5 * self.params.lift_height
         if not self._held() or self.lift_rise < want:
             below = self.arm.tcp_pose()[2, 3] - z1
-            raise MoveFailed("lift", f"object slipped, {below * 100:.1f} cm below the fingers (rose {self.lift_rise * 100:.1f} cm)")
+            hint = grasp_hint(self.arm, self.gripper.width())
+            raise MoveFailed("lift", f"object slipped, {below * 100:.1f} cm below the fingers (rose {self.lift_rise * 100:.1f} cm)"
+                             + (f"; {hint}" if hint else ""))
 
     # ---- world helpers -----------------------------------------------------------------------
     def _on_step(self) -> None:

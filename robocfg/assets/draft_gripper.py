@@ -1,0 +1,213 @@
+"""Find the gripper of a URDF for ``robocfg new-robot``: parallel, one-jaw, or the tip of a tool.
+
+All from structure and geometry, never from names. Geometry is measured exactly as
+``robocfg validate`` measures it (``robocfg.assets.fingers``: the distal ``PAD_LENGTH`` of each
+finger's collision geometry, in the ``ee_link`` frame, metres):
+
+* **parallel** — the non-mimic movable joints below the arm (leaders) move two finger links on
+  either side of the approach axis; ``open``/``closed`` are the leader limits with the wider and
+  the narrower pad gap;
+* **one-jaw** — the arm chain's last joint moves nothing but a leaf link (the jaw) whose pad
+  closes onto a link fixed to the joint's parent (the fixed jaw): gap ≤ ``JAW_CONTACT`` at one
+  limit and ≥ ``JAW_MIN_OPENING`` at the other. Without this test the jaw reads as a 7th arm joint;
+* **TCP** — the pad midpoint with the gripper *closed*, along the approach axis: linkage fingers
+  (Robotiq) slide forward as they close, and a small object is held with the fingers almost
+  closed (measured on the 2F-85: the open midpoint leaves the pads above a 5 cm cube's centre and
+  the grasp fails; the closed one holds). Closed and open agree for sliding fingers (Panda);
+* **no gripper joints** — the tool tip: the point of the rigidly attached links' geometry furthest
+  along an ee axis (for a suction cup, its face).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.assets.fingers import (
+    FingerGeometryMissing,
+    finger_points,
+    pad_gap,
+    pad_midpoint,
+    pad_points,
+)
+from robocfg.assets.paths import Resolver
+from robocfg.assets.urdf import Urdf
+
+AXES = "xyz"
+MIN_FINGER_SEPARATION = 0.005  # m: two pads closer than this across the approach axis are one side
+JAW_CONTACT = 0.005  # m: a jaw this close to the fixed jaw at one limit closes onto it
+JAW_MIN_OPENING = 0.015  # m: ... and opens at least this far at the other limit
+
+
+class UnsupportedGripper(Exception):
+    """The gripper joints exist but their geometry fits no gripper kind robocfg drafts (the message says why)."""
+
+
+@dataclass
+class GripperDraft:
+    """A finger gripper found in the URDF (leader joints and the finger geometry)."""
+
+    kind: str  # "parallel" | "one_jaw"
+    joints: list[str]
+    open: list[float]
+    closed: list[float]
+    finger_links: list[str]  # one-jaw: [moving jaw, fixed jaw]
+    max_width: float  # m, pad-face gap when open
+    min_width: float  # m, pad-face gap when closed
+    max_force: float
+    closing_axis: str  # ee axis of the closing direction (sign in closing_sign)
+    closing_sign: float = 1.0  # -1: the fingers close along −closing_axis (one-jaw only)
+    fixed_jaw_face: float | None = None  # m, one-jaw: fixed jaw's face along the closing direction
+
+
+@dataclass
+class GripperGeometry:
+    """What the draft needs besides the gripper block: the approach axis and the TCP distance."""
+
+    gripper: GripperDraft | None
+    ee_axis: str
+    tcp_offset: float  # m along +ee_axis
+
+
+def link_points(urdf: Urdf, resolver: Resolver, ee_link: str, links: list[str], q: dict[str, float]) -> dict[str, np.ndarray]:
+    """Geometry points (ee_link frame, m) of each of ``links`` that has geometry."""
+    T_inv = np.linalg.inv(urdf.link_pose(ee_link, q))
+    out = {}
+    for ln in links:
+        try:
+            (P,) = finger_points(urdf, resolver, [ln])
+        except FingerGeometryMissing:
+            continue
+        T = T_inv @ urdf.link_pose(ln, q)
+        out[ln] = P @ T[:3, :3].T + T[:3, 3]
+    return out
+
+
+def _approach_axis(clouds: dict[str, np.ndarray]) -> int:
+    centroid = np.concatenate(list(clouds.values())).mean(axis=0)
+    return int(np.argmax(centroid))
+
+
+def _pads(urdf: Urdf, resolver: Resolver, ee_link: str, pair: list[str], q: dict[str, float], axis: int) -> list[np.ndarray]:
+    return pad_points(urdf, ee_link, pair, finger_points(urdf, resolver, pair), q, axis)
+
+
+def _lateral(pads: list[np.ndarray], axis: int) -> np.ndarray:
+    """Unit vector from pad 0's centre to pad 1's, the approach component removed (zeros if none)."""
+    a, b = ((P.min(axis=0) + P.max(axis=0)) / 2 for P in pads)
+    d = b - a
+    d[axis] = 0.0
+    n = np.linalg.norm(d)
+    return d / n if n > 1e-9 else d
+
+
+def _finger_pair(clouds: dict[str, np.ndarray], axis: int) -> list[str]:
+    """The link reaching furthest along ``axis`` and the furthest-reaching one across from it."""
+    tips = sorted(clouds, key=lambda ln: -clouds[ln][:, axis].max())
+    if len(tips) < 2:
+        raise UnsupportedGripper(f"the gripper joints move {len(tips)} link(s) with geometry; two fingers are needed")
+
+    def centre(ln: str) -> np.ndarray:
+        P = clouds[ln]
+        pad = P[P[:, axis] >= P[:, axis].max() - 0.02]
+        return (pad.min(axis=0) + pad.max(axis=0)) / 2
+
+    for other in tips[1:]:
+        d = centre(other) - centre(tips[0])
+        d[axis] = 0.0
+        if np.linalg.norm(d) > MIN_FINGER_SEPARATION:
+            return [tips[0], other]
+    raise UnsupportedGripper(f"no two finger links on either side of the approach axis among {tips}")
+
+
+def _effort(urdf: Urdf, leaders: list[str]) -> float:
+    efforts = [urdf.joints[j].effort for j in leaders]
+    return float(min(e for e in efforts if e > 0)) if any(e > 0 for e in efforts) else 40.0
+
+
+def _limits(urdf: Urdf, leaders: list[str]) -> tuple[dict[str, float], dict[str, float]]:
+    return ({j: urdf.joints[j].lower for j in leaders}, {j: urdf.joints[j].upper for j in leaders})
+
+
+def parallel_gripper(urdf: Urdf, resolver: Resolver, ee_link: str, leaders: list[str]) -> GripperGeometry:
+    """Two fingers moved by ``leaders`` (and their mimic followers). Raises UnsupportedGripper."""
+    followers = [j.name for j in urdf.joints.values() if j.mimic is not None and j.mimic.joint in leaders]
+    moved = set().union(*(urdf.descendants(j) for j in leaders + followers))
+    leaves = sorted(ln for ln in moved if not any(j.parent == ln for j in urdf.joints.values()))
+    lo, hi = _limits(urdf, leaders)
+    clouds = link_points(urdf, resolver, ee_link, leaves, lo)
+    if len(clouds) < 2:
+        raise UnsupportedGripper(f"gripper joints {leaders} move {len(clouds)} link(s) with geometry; two fingers are needed")
+    axis = _approach_axis(clouds)
+    pair = _finger_pair(clouds, axis)
+    gaps = []
+    for q in (lo, hi):
+        pads = _pads(urdf, resolver, ee_link, pair, q, axis)
+        gaps.append(pad_gap(pads, _lateral(pads, axis)))
+    open_q, closed_q = (hi, lo) if gaps[1] > gaps[0] else (lo, hi)
+    closed_pads = _pads(urdf, resolver, ee_link, pair, closed_q, axis)
+    open_pads = _pads(urdf, resolver, ee_link, pair, open_q, axis)
+    c = _lateral(open_pads, axis)
+    closing = int(np.argmax(np.abs(c)))
+    if closing == axis:
+        closing = (axis + 1) % 3
+    tcp = float(pad_midpoint(closed_pads)[axis])
+    g = GripperDraft("parallel", leaders, [round(open_q[j], 6) for j in leaders], [round(closed_q[j], 6) for j in leaders],
+                     pair, round(max(max(gaps), 1e-3), 4), round(max(min(gaps), 0.0), 4), _effort(urdf, leaders), AXES[closing])
+    return GripperGeometry(g, AXES[axis], tcp)
+
+
+def one_jaw_gripper(urdf: Urdf, resolver: Resolver, chain: list[str], ee_link: str) -> GripperGeometry | None:
+    """The one-jaw gripper whose jaw is ``chain[-1]``, or None when that joint is not a jaw."""
+    jaw = urdf.joints[chain[-1]]
+    moved = urdf.descendants(jaw.name)
+    if any(j.movable for j in urdf.joints.values() if j.parent in moved):
+        return None
+    lo, hi = _limits(urdf, [jaw.name])
+    fixed_cands = [jaw.parent] + [j.child for j in urdf.joints.values() if j.parent == jaw.parent and not j.movable]
+    moving = link_points(urdf, resolver, ee_link, sorted(moved), lo)
+    fixed = link_points(urdf, resolver, ee_link, fixed_cands, lo)
+    if not moving or not fixed:
+        return None
+    axis = _approach_axis({**moving, **fixed})
+    jaw_link = max(moving, key=lambda ln: moving[ln][:, axis].max())
+    fixed_link = max(fixed, key=lambda ln: fixed[ln][:, axis].max())
+    pair = [jaw_link, fixed_link]
+    gaps, dirs = [], []
+    for q in (lo, hi):
+        pads = _pads(urdf, resolver, ee_link, pair, q, axis)
+        d = _lateral(pads, axis)  # moving pad → fixed pad
+        gaps.append(pad_gap(pads, d) if np.linalg.norm(d) > 0 else 0.0)
+        dirs.append(d)
+    k_closed = int(np.argmin(gaps))
+    if gaps[k_closed] > JAW_CONTACT or max(gaps) < JAW_MIN_OPENING:
+        return None
+    open_q, closed_q = (hi, lo) if k_closed == 0 else (lo, hi)
+    c = dirs[1 - k_closed]  # at the open limit: from the moving jaw towards the fixed one
+    closing = int(np.argmax(np.abs(c)))
+    if closing == axis:
+        return None
+    sign = float(np.sign(c[closing]))
+    unit = np.zeros(3)
+    unit[closing] = sign
+    fixed_pad = _pads(urdf, resolver, ee_link, pair, open_q, axis)[1]
+    face = float((fixed_pad @ unit).min())
+    tcp = float(pad_midpoint(_pads(urdf, resolver, ee_link, pair, closed_q, axis))[axis])
+    g = GripperDraft("one_jaw", [jaw.name], [round(open_q[jaw.name], 6)], [round(closed_q[jaw.name], 6)], pair,
+                     round(max(gaps), 4), round(max(min(gaps), 0.0), 4), _effort(urdf, [jaw.name]), AXES[closing],
+                     sign, round(face, 4))
+    return GripperGeometry(g, AXES[axis], tcp)
+
+
+def tool_tip(urdf: Urdf, resolver: Resolver, ee_link: str, links: list[str]) -> tuple[GripperGeometry, str] | None:
+    """(ee axis and distance to the furthest point of the rigid links' geometry, the link it
+    belongs to), or None without geometry. For a suction tool that point is the cup face."""
+    clouds = link_points(urdf, resolver, ee_link, links, {})
+    if not clouds:
+        return None
+    best = max(((ln, k, float(P[:, k].max())) for ln, P in clouds.items() for k in range(3)), key=lambda t: t[2])
+    ln, k, d = best
+    if d <= 0:
+        return None
+    return GripperGeometry(None, AXES[k], d), ln

@@ -1,0 +1,71 @@
+"""A home pose for a robot that has none yet (``robocfg new-robot``): the tool pointing straight
+down over the workspace in front of the robot, found by IK.
+
+The reach is estimated from forward kinematics over joint samples (the largest horizontal TCP
+distance from the first joint's axis); targets are tried at fractions of it in front of the base
+(+x of the root link) and at heights above the base, with the fingers closing along world y, then
+x. Among the IK answers that converge for the first target that works, the one furthest from the
+joint limits wins (so ``home_std`` has room). Frames: the robot's root link at the world origin,
+metres, radians.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
+from robocfg.kinematics.model import KinematicModel
+
+REACH_SAMPLES = 400
+DISTANCES = (0.5, 0.4, 0.6, 0.3)  # fractions of the reach, in front of the base
+HEIGHTS = (0.3, 0.2, 0.4, 0.1)  # fractions of the reach, above the first joint's origin
+IK_BUDGET = 0.2  # s per IK call
+
+
+def reach(model: KinematicModel, rng: np.random.Generator) -> tuple[float, float]:
+    """(horizontal reach m, mid-height m of the reachable TCP positions) from FK over random joint samples."""
+    lo = np.where(np.isfinite(model.lower), model.lower, -np.pi)
+    hi = np.where(np.isfinite(model.upper), model.upper, np.pi)
+    pts = np.array([model.fk(q)[:3, 3] for q in rng.uniform(lo, hi, (REACH_SAMPLES, model.nq))])
+    z0 = float(pts[:, 2].min() + pts[:, 2].max()) / 2
+    return float(np.max(np.linalg.norm(pts[:, :2], axis=1))), z0
+
+
+def find_home(model: KinematicModel, seed: int = 0) -> np.ndarray | None:
+    """Joint values (arm order) with the tool pointing down over the workspace, or None when no
+    target in front of the robot is reachable with the tool down."""
+    rng = np.random.default_rng(seed)
+    r, z0 = reach(model, rng)
+    arm = model.robot.config.arm() if model.robot is not None else None
+    if arm is None:
+        return None
+    lo = np.where(np.isfinite(model.lower), model.lower, -np.pi)
+    hi = np.where(np.isfinite(model.upper), model.upper, np.pi)
+    seeds = [np.clip(np.array(model.home, float), lo, hi), (lo + hi) / 2]
+    for d in DISTANCES:
+        for h in HEIGHTS:
+            centre = np.array([d * r, 0.0, z0 + (h - 0.3) * r])
+            best, best_score = None, np.inf
+            for closing in ((0.0, 1.0, 0.0), (1.0, 0.0, 0.0)):
+                grasp = Grasp(centre, grasp_rotation(np.array([0.0, 0.0, -1.0]), np.array(closing)), 0.0)
+                target = ee_pose_from_grasp(grasp, arm)
+                for s in seeds:
+                    res = model.ik(target, seed_q=s, frame="ee", time_budget=IK_BUDGET, rng=rng)
+                    if not res.converged or not model.within_limits(res.q):
+                        continue
+                    score = _limit_score(res.q, model)
+                    if score < best_score:
+                        best, best_score = res.q, score
+            if best is not None:
+                return best
+    return None
+
+
+def _limit_score(q: np.ndarray, model: KinematicModel) -> float:
+    """Sum of squared normalised distances from mid-range (0 at the middle, 1 at a limit) over bounded joints."""
+    bounded = np.isfinite(model.lower) & np.isfinite(model.upper) & (model.upper - model.lower < 2 * np.pi - 1e-6)
+    if model.continuous is not None:
+        bounded &= ~model.continuous
+    half = (model.upper - model.lower) / 2
+    mid = (model.upper + model.lower) / 2
+    return float(np.sum(((q - mid)[bounded] / half[bounded]) ** 2))
