@@ -31,6 +31,7 @@ import numpy as np
 
 from robocfg.assets.draft_gripper import (
     GripperDraft,
+    GripperGeometry,
     UnsupportedGripper,
     one_jaw_gripper,
     parallel_gripper,
@@ -90,19 +91,21 @@ def draft_robot(urdf: Urdf, name: str, out_dir: Path, urdf_uri: str | None = Non
     if not chain:
         raise ValueError(f"{urdf.path}: no movable joints, nothing to drive")
     resolver = Resolver(urdf.path.parent)
-    found = None
+    found: GripperGeometry | None = None
+    jaw_parent: str | None = None
     if len(chain) > 1:  # a jaw at the end of the serial chain (one-jaw gripper) is not an arm joint
         found = one_jaw_gripper(urdf, resolver, chain, urdf.joints[chain[-1]].parent)
-        if found is not None:
-            notes.append(f"one-jaw gripper: {chain[-1]!r} moves {found.gripper.finger_links[0]!r} against the fixed jaw "
-                         f"{found.gripper.finger_links[1]!r}")
+        if found is not None and found.gripper is not None:
+            fingers = found.gripper.finger_links
+            notes.append(f"one-jaw gripper: {chain[-1]!r} moves {fingers[0]!r} against the fixed jaw {fingers[1]!r}")
+            jaw_parent = urdf.joints[chain[-1]].parent
             chain = chain[:-1]
     base_link = urdf.joints[chain[0]].parent
     cands = ee_candidates(urdf, chain)
     below = urdf.descendants(chain[-1])
     leaders = [j.name for j in urdf.joints.values()
                if j.movable and j.mimic is None and j.name not in chain and j.parent in below]
-    ee_link = urdf.joints[found.gripper.joints[0]].parent if found is not None else _pick_ee_link(urdf, cands, leaders)
+    ee_link = jaw_parent or _pick_ee_link(urdf, cands, leaders)
     suction_link = None
     if found is None and leaders:
         try:
@@ -118,8 +121,6 @@ def draft_robot(urdf: Urdf, name: str, out_dir: Path, urdf_uri: str | None = Non
         if tip is not None:
             found, suction_link = tip
         else:
-            from robocfg.assets.draft_gripper import GripperGeometry
-
             found = GripperGeometry(None, "z", 0.1)
             notes.append("no tool geometry: ee_axis z and tcp_offset 0.1 are placeholders")
     gripper, ee_axis, tcp = found.gripper, found.ee_axis, found.tcp_offset
@@ -161,8 +162,8 @@ def draft_composed(source: Path, src: RobotSource, name: str, out_dir: Path) -> 
 
     resolver = Resolver(source.parent, src.package_dirs)
     base = resolver.urdf(src.urdf)
-    parts = [Part(resolver.urdf(a.urdf), a.mount_link, tuple(a.mount_xyz), rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix)
-             for a in src.attachments]
+    parts = [Part(resolver.urdf(a.urdf), a.mount_link, (a.mount_xyz[0], a.mount_xyz[1], a.mount_xyz[2]),
+                  rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix) for a in src.attachments]
     composed = compose(base, parts, resolver).path
     d = draft_robot(parse_urdf(composed), name, out_dir, urdf_uri=_rebase(src.urdf, source.parent, out_dir))
     d.attachments = [AttachmentDraft(_rebase(a.urdf, source.parent, out_dir), a.mount_link, list(a.mount_xyz),
