@@ -73,3 +73,11 @@ def test_closes_on_a_cube_and_holds_it_through_a_lift(tmp_path):
         g.open()
         w.step(round(1.0 / w.dt))
         assert not g.is_grasping("cube") and w.body_pose("cube")[0][2] < CUBE / 2 + 0.005
+
+
+def test_run_gripper_holds_the_cube_beside_the_fixed_jaw(tmp_path, capsys, monkeypatch):
+    from _cli import run_main
+
+    code, out, err = run_main(["run", "gripper", "--robot", str(ROBOT), "-q"], capsys, monkeypatch, tmp_path)
+    assert code == 0, err
+    assert out.startswith("ok: sim_onejaw one_jaw gripper closed 0.0 mm") and "cube held" in out

@@ -174,28 +174,46 @@ def one_jaw_gripper(urdf: Urdf, resolver: Resolver, chain: list[str], ee_link: s
     jaw_link = max(moving, key=lambda ln: moving[ln][:, axis].max())
     fixed_link = max(fixed, key=lambda ln: fixed[ln][:, axis].max())
     pair = [jaw_link, fixed_link]
-    gaps, dirs = [], []
-    for q in (lo, hi):
-        pads = _pads(urdf, resolver, ee_link, pair, q, axis)
-        d = _lateral(pads, axis)  # moving pad → fixed pad
-        gaps.append(pad_gap(pads, d) if np.linalg.norm(d) > 0 else 0.0)
-        dirs.append(d)
-    k_closed = int(np.argmin(gaps))
-    if gaps[k_closed] > JAW_CONTACT or max(gaps) < JAW_MIN_OPENING:
+    for closed_q, open_q in ((lo, hi), (hi, lo)):
+        found = _jaw_at(urdf, resolver, ee_link, jaw.name, pair, closed_q, open_q, axis)
+        if found is not None:
+            return found
+    return None
+
+
+def jaw_opening(urdf: Urdf, ee_link: str, jaw_link: str, moving_pad: np.ndarray, q_from: dict[str, float],
+                q_to: dict[str, float]) -> np.ndarray:
+    """The moving jaw's pad points (ee_link frame) carried rigidly from joint values ``q_from`` to
+    ``q_to``: a revolute jaw's tip swings away, which the distal part re-measured at ``q_to`` (the
+    jaw's side, once it has turned) would not show."""
+    def pose(q: dict[str, float]) -> np.ndarray:
+        return np.linalg.inv(urdf.link_pose(ee_link, q)) @ urdf.link_pose(jaw_link, q)
+
+    T = pose(q_to) @ np.linalg.inv(pose(q_from))
+    return moving_pad @ T[:3, :3].T + T[:3, 3]
+
+
+def _jaw_at(urdf: Urdf, resolver: Resolver, ee_link: str, joint: str, pair: list[str], closed_q: dict[str, float],
+            open_q: dict[str, float], axis: int) -> GripperGeometry | None:
+    """The one-jaw gripper if the jaw touches the fixed jaw at ``closed_q`` and opens at ``open_q``."""
+    pads = _pads(urdf, resolver, ee_link, pair, closed_q, axis)
+    c = _lateral(pads, axis)  # moving pad → fixed pad: the closing direction
+    if not np.linalg.norm(c):
         return None
-    open_q, closed_q = (hi, lo) if k_closed == 0 else (lo, hi)
-    c = dirs[1 - k_closed]  # at the open limit: from the moving jaw towards the fixed one
+    gap_closed = pad_gap(pads, c)
+    gap_open = pad_gap([jaw_opening(urdf, ee_link, pair[0], pads[0], closed_q, open_q), pads[1]], c)
+    if gap_closed > JAW_CONTACT or gap_open < JAW_MIN_OPENING:
+        return None
     closing = int(np.argmax(np.abs(c)))
     if closing == axis:
         return None
     sign = float(np.sign(c[closing]))
     unit = np.zeros(3)
     unit[closing] = sign
-    fixed_pad = _pads(urdf, resolver, ee_link, pair, open_q, axis)[1]
-    face = float((fixed_pad @ unit).min())
-    tcp = float(pad_midpoint(_pads(urdf, resolver, ee_link, pair, closed_q, axis))[axis])
-    g = GripperDraft("one_jaw", [jaw.name], [round(open_q[jaw.name], 6)], [round(closed_q[jaw.name], 6)], pair,
-                     round(max(gaps), 4), round(max(min(gaps), 0.0), 4), _effort(urdf, [jaw.name]), AXES[closing],
+    face = float((pads[1] @ unit).min())
+    tcp = float(pad_midpoint(pads)[axis])
+    g = GripperDraft("one_jaw", [joint], [round(open_q[joint], 6)], [round(closed_q[joint], 6)], pair,
+                     round(gap_open, 4), round(max(gap_closed, 0.0), 4), _effort(urdf, [joint]), AXES[closing],
                      sign, round(face, 4))
     return GripperGeometry(g, AXES[axis], tcp)
 

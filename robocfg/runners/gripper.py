@@ -62,7 +62,7 @@ class _Run:
 
     def move_time(self) -> float:
         """Time given to one close/open: ``hold_time``, plus the target ramp in smooth mode."""
-        ramp = 1.0 / self.params.rate if self.params.mode == "smooth" and self.result.gripper_type == "parallel" else 0.0
+        ramp = 1.0 / self.params.rate if self.params.mode == "smooth" and not self.gripper.grasps_at_surface else 0.0
         return self.params.hold_time + ramp
 
     def move(self, phase: str, cycle: int, command) -> Move:
@@ -136,10 +136,11 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
             view = camera or facing_camera(tcp[:3, 3], closing, world.robot.base_pose()[:3, 3], distance=0.35)
             recorder = Recorder(world, record, fps=fps, camera=view)
         run = _Run(world, params, result, recorder, arm_cfg.name)
-        if g_cfg.type == "parallel":
+        fingers = isinstance(g_cfg, ParallelGripperConfig)  # parallel and one-jaw: fingers that close
+        if fingers:
             run.gripper.rate = params.rate if params.mode == "smooth" else None
         try:
-            if g_cfg.type == "parallel":
+            if fingers:
                 _parallel(run)
             else:
                 _suction(run)
@@ -213,6 +214,21 @@ def _place_object(run: _Run, at: np.ndarray, R: np.ndarray):
     return name, support
 
 
+def _grasp_centre(run: _Run, tcp: np.ndarray) -> np.ndarray:
+    """Where the hold object's centre goes: the TCP, moved across by ``grasp_side_shift`` at the
+    object's width along the closing direction (a one-jaw gripper holds it against its fixed jaw)."""
+    from robocfg.kinematics.frames import grasp_side_shift
+
+    cfg = run.arm.config
+    spec = next((b for b in run.world.task.config.scene.objects if b.name == run.params.hold_object), None)
+    closing_ee = np.asarray(cfg.R_ee_graspnet, float)[1]
+    if spec is None:
+        return tcp[:3, 3]
+    k = int(np.argmax(np.abs(closing_ee)))
+    width = float(spec.size[k]) if spec.shape == "box" else 2 * float(spec.size[0])
+    return tcp[:3, 3] + grasp_side_shift(cfg, width) * (tcp[:3, :3] @ closing_ee)
+
+
 def _half_extent_z(world, name: str) -> float:
     lo, hi = world.aabb(name)
     return float(hi[2] - lo[2]) / 2
@@ -243,7 +259,7 @@ def _lower_support(run: _Run, support: Body) -> None:
 def _hold_test(run: _Run) -> None:
     w, g, res = run.world, run.gripper, run.result
     tcp = run.arm.tcp_pose()
-    name, support = _place_object(run, tcp[:3, 3], run.arm.ee_pose()[:3, :3])
+    name, support = _place_object(run, _grasp_centre(run, tcp), run.arm.ee_pose()[:3, :3])
     run.run_for(SETTLE_TIME)
     run.move("grasp", 0, g.close)
     grasp_before = g.is_grasping(name)

@@ -80,7 +80,7 @@ class GripperResult:
         if not self.success:
             return f"failed: {self.failed_phase}: {self.reason}"
         held = "" if self.hold is None else f", {self.hold.object} {'held' if self.hold.held else 'NOT held'}"
-        if self.gripper_type != "parallel":
+        if self.gripper_type == "suction":
             released = "" if self.hold is None else f", {'released' if self.hold.released else 'NOT released'} when off"
             return f"ok: {self.robot} {self.gripper_type} gripper{held}{released}"
         return (f"ok: {self.robot} {self.gripper_type} gripper closed {_mm(self.final_closed_width)} in "
@@ -95,7 +95,7 @@ class GripperResult:
         ]
         if self.hold is not None:
             h = self.hold
-            touching = "both fingers touching" if self.gripper_type == "parallel" else "attached"
+            touching = "attached" if self.gripper_type == "suction" else "both fingers touching"
             rows += [("hold object", h.object), ("width on object", _mm(h.width_on_object)),
                      ("support lowered by", _mm(h.support_lowered_by) if h.support_lowered_by > 0 else "removed"),
                      ("held", f"{h.held} (sank {_mm(h.drop)}, {touching}: {h.grasping_after})"),
