@@ -77,3 +77,19 @@ def test_follow_target_runs_on_continuous_joints(tmp_path, capsys, monkeypatch):
     r = json.loads(out.read_text())
     assert r["success"] and r["reached"]
     assert r["position_error_mm"]["rms"] < 3.0 and r["orientation_error_deg"]["max"] < 1.0
+
+
+def test_controller_urdf_has_one_angle_per_continuous_joint_and_no_name_clash(tmp_path):
+    """What the follow-target controller hands placo: continuous joints revolute (one coordinate),
+    and a fixed joint named like a link (Unitree Z1's 'gripperStator') renamed."""
+    import xml.etree.ElementTree as ET
+
+    from robocfg.motion.reactive.controller import _urdf_without_geometry
+
+    text = (DATA / "sim_onejaw.urdf").read_text().replace('joint name="palm_joint"', 'joint name="palm"')
+    (tmp_path / "r.urdf").write_text(text)
+    root = ET.fromstring(_urdf_without_geometry(tmp_path / "r.urdf"))
+    joints = {j.get("name"): j for j in root.iter("joint")}
+    assert joints["j1"].get("type") == joints["j6"].get("type") == "revolute"
+    assert "palm" not in joints and joints["palm__fixed_joint"].get("type") == "fixed"
+    assert not root.findall(".//collision") and not root.findall(".//visual")

@@ -5,7 +5,8 @@ The reach is estimated from forward kinematics over joint samples (the largest h
 distance from the first joint's axis); targets are tried at fractions of it in front of the base
 (+x of the root link) and at heights above the base, with the fingers closing along world y, then
 x. Among the IK answers that converge for the first target that works, the one furthest from the
-joint limits wins (so ``home_std`` has room). Frames: the robot's root link at the world origin,
+joint limits wins; a target whose answers all come within ``LIMIT_MARGIN`` of a limit is passed
+over for the next (so ``home_std`` has room), and used only when no target does better. Frames: the robot's root link at the world origin,
 metres, radians.
 """
 
@@ -20,6 +21,7 @@ REACH_SAMPLES = 400
 DISTANCES = (0.5, 0.4, 0.6, 0.3)  # fractions of the reach, in front of the base
 HEIGHTS = (0.3, 0.2, 0.4, 0.1)  # fractions of the reach, above the first joint's origin
 IK_BUDGET = 0.2  # s per IK call
+LIMIT_MARGIN = 0.16  # rad: a home this far inside every limit leaves room for 3 × the draft's home_std (0.05)
 
 
 def reach(model: KinematicModel, rng: np.random.Generator) -> tuple[float, float]:
@@ -42,6 +44,7 @@ def find_home(model: KinematicModel, seed: int = 0) -> np.ndarray | None:
     lo = np.where(np.isfinite(model.lower), model.lower, -np.pi)
     hi = np.where(np.isfinite(model.upper), model.upper, np.pi)
     seeds = [np.clip(np.array(model.home, float), lo, hi), (lo + hi) / 2]
+    fallback = None
     for d in DISTANCES:
         for h in HEIGHTS:
             centre = np.array([d * r, 0.0, z0 + (h - 0.3) * r])
@@ -56,9 +59,18 @@ def find_home(model: KinematicModel, seed: int = 0) -> np.ndarray | None:
                     score = _limit_score(res.q, model)
                     if score < best_score:
                         best, best_score = res.q, score
-            if best is not None:
+            if best is not None and _clear_of_limits(best, model):
                 return best
-    return None
+            fallback = best if fallback is None else fallback
+    return fallback
+
+
+def _clear_of_limits(q: np.ndarray, model: KinematicModel) -> bool:
+    """Every bounded joint at least LIMIT_MARGIN from its limits (room for the draft's home_std)."""
+    bounded = np.isfinite(model.lower) & np.isfinite(model.upper)
+    if model.continuous is not None:
+        bounded &= ~model.continuous
+    return bool(np.all(((q - model.lower) >= LIMIT_MARGIN) | ~bounded) and np.all(((model.upper - q) >= LIMIT_MARGIN) | ~bounded))
 
 
 def _limit_score(q: np.ndarray, model: KinematicModel) -> float:

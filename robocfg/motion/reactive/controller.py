@@ -91,7 +91,8 @@ class StepResult:
 
 
 def _urdf_without_geometry(path: Path) -> str:
-    """The URDF text without ``<visual>``/``<collision>`` elements (placo then loads no meshes), and
+    """The URDF text without ``<visual>``/``<collision>`` elements (placo then loads no meshes), fixed
+    joints named like a link renamed (Unitree's Z1 has a link and a joint ``gripperStator``), and
     with continuous joints made revolute: pinocchio gives a continuous joint two coordinates
     (cos, sin), this controller one angle per joint. The angle is left unwrapped (the box bounds of
     a continuous joint are infinite), so a joint that turns past ±π keeps turning smoothly."""
@@ -102,7 +103,10 @@ def _urdf_without_geometry(path: Path) -> str:
         for tag in ("visual", "collision"):
             for el in link.findall(tag):
                 link.remove(el)
+    links = {link.get("name") for link in root.iter("link")}
     for joint in root.iter("joint"):
+        if joint.get("type") == "fixed" and joint.get("name") in links:  # placo cannot tell a link from a joint of the same name
+            joint.set("name", f"{joint.get('name')}__fixed_joint")
         if joint.get("type") == "continuous":
             joint.set("type", "revolute")
             limit = joint.find("limit")
