@@ -168,6 +168,8 @@ class RobotEnv(gym.Env):
         return self._renderer.render()
 
     def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
         self.world.close()
 
     # ---- helpers ---------------------------------------------------------------------------
