@@ -7,7 +7,7 @@ Part 1 renders the default pick-place scene (Panda at home, the cube) ``--frames
 renderer and image size, in one process: ``exact`` = the world's own meshes through
 ``getCameraImage`` (what recordings did before); ``full`` = the render mirror with the original
 meshes (static bodies baked once, the rest drawn alone and merged by depth); ``tiny`` = the mirror
-with meshes cut to 1500 triangles (the default); ``tiny500`` = 500 triangles; ``egl`` = the mirror
+with meshes cut to ``MAX_FACES`` (1000) triangles (the default); ``tiny500`` = 500 triangles; ``egl`` = the mirror
 through PyBullet's EGL plugin (OpenGL; on a machine without a GPU Mesa's llvmpipe runs it on the
 CPU). ms/frame is CPU time of this process (less sensitive to other jobs than wall time; llvmpipe's
 worker threads count too); frames/s is wall-clock.
@@ -31,8 +31,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from robocfg.sim.render_mirror import MAX_FACES
+
 SIZES = ((160, 120), (240, 180), (320, 240), (480, 360), (640, 480))
-FACES = {"full": None, "tiny": 1500, "tiny500": 500, "egl": 1500}
+FACES = {"full": None, "tiny": MAX_FACES, "tiny500": 500, "egl": MAX_FACES}
 
 
 def renderer_rates(renderers: list[str], frames: int) -> list[dict]:

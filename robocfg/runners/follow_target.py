@@ -304,7 +304,7 @@ class _FollowRun:
         if self.recorder is not None:
             r.record = str(self.recorder.save())
         if plot is not None and self.series:
-            r.plot = str(plot_series(plot, self.series, r.safety_margin))
+            r.plot = str(plot_series(plot, self.series, r, self.params))
         r.wall_time = time.perf_counter() - t_wall
         if self.failure is not None:
             raise RunFailed(self.failure.phase, self.failure.reason, report=r) from None

@@ -188,31 +188,15 @@ def _reached(result: FollowTargetResult, params: FollowTargetParams, ctrl: Any) 
     return False, "outside the workspace (or at a joint limit) for this orientation"
 
 
-def plot_series(path: Path, series: list[tuple[float, float, float, float]], margin: float) -> Path:
-    """Tracking errors and clearance against time, as a PNG at ``path``."""
-    import matplotlib
+def plot_series(path: Path, series: list[tuple[float, float, float, float]], result: FollowTargetResult,
+                params: FollowTargetParams) -> Path:
+    """Tracking errors (own log axes) and clearance against time, as a PNG at ``path``
+    (:mod:`robocfg.motion.plot_tracking`)."""
+    from robocfg.motion.plot_tracking import TrackingSeries, plot_tracking
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    a = np.asarray(series, float)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True)
-    axes[0].plot(a[:, 0], a[:, 1] * 1000, label="position error (mm)")
-    ax2 = axes[0].twinx()
-    ax2.plot(a[:, 0], np.degrees(a[:, 2]), color="tab:orange", label="orientation error (deg)")
-    axes[0].set_ylabel("position error (mm)")
-    ax2.set_ylabel("orientation error (deg)")
-    clear = np.where(np.isinf(a[:, 3]), np.nan, a[:, 3] * 1000)
-    axes[1].plot(a[:, 0], clear, label="robot–obstacle clearance")
-    axes[1].axhline(margin * 1000, color="tab:red", linestyle="--", label="safety margin")
-    axes[1].set_ylabel("clearance (mm)")
-    axes[1].set_xlabel("t (s)")
-    axes[1].legend(loc="upper right")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path
+    title = f"{result.robot}: follow {result.motion} target" + (" with obstacle" if result.with_obstacle else "")
+    return plot_tracking(path, TrackingSeries.from_rows(series), settle_time=result.settle_time,
+                         position_tolerance=params.reach_tolerance, orientation_tolerance=params.orientation_tolerance,
+                         safety_margin=result.safety_margin, title=title)
 
 
