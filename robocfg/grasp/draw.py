@@ -3,13 +3,15 @@ outlines are projected with the recorder's own camera and drawn with Pillow).
 
 Each grasp is a U: two fingers (from the fingertips back along the approach, at ±width/2 along
 the closing axis), the palm between them, and a stem back along the approach. The best grasp is
-green, the others orange.
+green, the others orange. The outlines are kept in the object's frame (its base frame when the
+grasps were planned), so they move with the object when it is lifted; a legend says which is which.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from robocfg.geometry import quat_to_matrix
 from robocfg.sim.record import Recorder
 
 BEST = (40, 220, 60)
@@ -32,30 +34,62 @@ class GraspRecorder(Recorder):
     def __post_init__(self) -> None:
         super().__post_init__()
         self.grasps: list = []
+        self.outlines: list[list[np.ndarray]] = []  # per grasp, polylines in the object's frame (m)
+        self.obj: int | None = None
 
-    def show(self, grasps, boxes=None) -> None:
-        """Draw these grasps (best first) from now on; ``boxes`` (GripperBoxes) sizes the fingers."""
+    def show(self, grasps, boxes=None, obj: int | None = None) -> None:
+        """Draw these grasps (best first) from now on; ``boxes`` (GripperBoxes) sizes the fingers;
+        ``obj``: the grasped body, whose motion the outlines follow (None: they stay in place)."""
         self.grasps = list(grasps)
         if boxes is not None:
             x0, x1 = boxes.finger_depth()
             self.finger_length = max(0.01, x1 - x0)
+        self.obj = obj
+        p0, R0 = self._object_pose()
+        self.outlines = [[(line - p0) @ R0 for line in grasp_polylines(g, getattr(self, "finger_length", 0.05))]
+                         for g in self.grasps]
         if self.animate:  # hold the planning frame a moment (same picture, three frames)
             frame, info = self.render(), self.info()
             for _ in range(3):
                 self.keep(frame, info)
 
+    def _object_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """(position (3,), rotation (3, 3)) of the object now; the world frame without one."""
+        if self.obj is None:
+            return np.zeros(3), np.eye(3)
+        pos, quat = self.world.body_pose(self.obj)
+        return np.asarray(pos, float), quat_to_matrix(quat)
+
     def render(self) -> np.ndarray:
         frame = super().render()
-        if not self.grasps:
+        if not self.outlines:
             return frame
         from PIL import Image, ImageDraw
 
         img = Image.fromarray(frame)
         draw = ImageDraw.Draw(img)
-        for k, g in reversed(list(enumerate(self.grasps))):
-            for line in grasp_polylines(g, getattr(self, "finger_length", 0.05)):
-                px, front = self.project(line)
+        p, R = self._object_pose()
+        for k, lines in reversed(list(enumerate(self.outlines))):
+            for line in lines:
+                px, front = self.project(line @ R.T + p)
                 if not front.all():
                     continue
                 draw.line([tuple(q) for q in px], fill=BEST if k == 0 else OTHER, width=2 if k == 0 else 1)
+        _legend(draw, img.size, len(self.outlines))
         return np.asarray(img)
+
+
+def _legend(draw, size: tuple[int, int], n: int) -> None:
+    """Bottom-left key: best grasp, the other candidates."""
+    from robocfg.sim.record_overlay import font
+
+    f = font(max(10, size[1] // 26))
+    rows = [(BEST, "best grasp")] + ([(OTHER, f"other candidates ({n - 1})")] if n > 1 else [])
+    line_h = f.size + 4 if hasattr(f, "size") else 14
+    y = size[1] - 6 - line_h * len(rows)
+    width = 24 + max(int(draw.textlength(text, font=f)) for _, text in rows)
+    draw.rectangle([4, y - 3, 10 + width, size[1] - 4], fill=(255, 255, 255))
+    for color, text in rows:
+        draw.line([(8, y + line_h // 2), (24, y + line_h // 2)], fill=color, width=3)
+        draw.text((28, y), text, fill=(0, 0, 0), font=f)
+        y += line_h

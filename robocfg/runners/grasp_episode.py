@@ -147,7 +147,7 @@ class _Episode:
         from robocfg.grasp.draw import GraspRecorder
 
         if isinstance(self.recorder, GraspRecorder):
-            self.recorder.show([c.grasp for c in plan.candidates], self.ctx.boxes)
+            self.recorder.show([c.grasp for c in plan.candidates], self.ctx.boxes, self.obj)
         self.log(f"Plan {attempt + 1}: {len(per.objects)} object points, {plan.poses} poses, "
                  f"{len(plan.candidates)} reachable candidates, best score "
                  f"{plan.candidates[0].score if plan.candidates else float('nan'):.3f} ({plan.time_s:.2f} s)")
