@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pybullet as p
@@ -19,6 +20,9 @@ import pybullet as p
 from robocfg.errors import RobocfgError
 from robocfg.sim.record_overlay import FrameInfo, Marker, contact_sheet, draw_markers, draw_status
 from robocfg.sim.render_mirror import MAX_FACES, RenderMirror
+
+if TYPE_CHECKING:
+    from robocfg.sim.world import World
 
 
 @dataclass(frozen=True)
@@ -52,7 +56,7 @@ class Recorder:
     an NVIDIA GPU is present and its plugin loads, else ``"tiny"``.
     """
 
-    world: object
+    world: World
     path: Path | str
     fps: float = 10.0
     size: tuple[int, int] = (320, 240)
