@@ -2,7 +2,7 @@
 
     python benchmarks/bench_grasp.py --episodes 100 [--robots panda,ur5e_robotiq_2f85] [--seed 0] [--json out.json]
 
-Episode k grasps ``objects[k % 9]`` of ``tasks/grasp.yaml`` (boxes at random yaw, standing and lying
+Episode k grasps ``objects[k % 9]`` of the built-in ``grasp`` task (boxes at random yaw, standing and lying
 cylinders, a sphere, pybullet_data meshes) at a random spot; success = held after a 15 cm lift and
 a ±4 cm shake, within ``max_attempts`` (3) grasps. Planning time = one plan: antipodal sampling,
 scoring, collision checks and IK reachability (the rendering and cloud processing are reported

@@ -5,7 +5,7 @@ Same targets as `robocfg bench ik` (TRAC-IK's protocol: N configurations uniform
 targets = FK of ee_link, seed = mid-limits, success = 1e-5 m, 1e-5 rad, within limits). Each query
 may use at most K LM iterations in total (all restarts included); no time limit.
 
-    python benchmarks/bench_ik_iterations.py [--robot panda] [--n 1000] [--budgets 25,50,100,200]
+    python benchmarks/bench_ik_iterations.py [--robot panda] [-n 1000] [--budgets 25,50,100,200]
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from robocfg.kinematics.model import KinematicModel
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--robot", default="panda")
-    ap.add_argument("--n", type=int, default=1000)
+    ap.add_argument("-n", "--targets", dest="n", type=int, default=1000)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--budgets", default="25,50,100,200")
     args = ap.parse_args()

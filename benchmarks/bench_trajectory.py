@@ -6,14 +6,14 @@
 * stop — one synchronised trapezoid per segment, at rest at every waypoint (Isaac Sim's
   ``to_minimal_time_joint_trajectory`` semantics).
 
-Paths: the seed's home → reach-out → home (``tasks/trajectory.yaml``); a 6-waypoint "via-point"
+Paths: home → reach-out → home (the built-in ``trajectory`` task); a 6-waypoint "via-point"
 route (waypoints on a curved joint-space route, as a motion planner outputs them); a 6-waypoint
 zig-zag (random waypoints in a box around home, seed 0: joints reverse at most waypoints).
 Also: planning time (first call in the process and median of warm calls), limit violations
 resampled at 1 kHz, and Panda tracking in PyBullet (RMS and final error, our follower vs the naive
 "command the next sample" follower).
 
-    python benchmarks/bench_trajectory.py [--task tasks/trajectory.yaml] [--repeats 20] [--scale S] [--json out.json]
+    python benchmarks/bench_trajectory.py [--task robocfg/data/tasks/trajectory.yaml] [--repeats 20] [--scale S] [--json out.json]
 
 Goals: ours within 2 % of the optimum; ≥ 25 % shorter than stop on the 6-waypoint via-point path;
 planning ≤ 20 ms; 0 violations; tracking RMS ≤ 0.005 rad and final error ≤ 0.002 rad.

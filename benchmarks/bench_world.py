@@ -1,7 +1,7 @@
 """Steps per second of ``World.step()`` (holding the robot at home) vs a bare ``p.stepSimulation()``
 loop on the same scene, in one run; plus the whole-process time of ``robocfg run gripper``.
 
-    python benchmarks/bench_world.py [--task tasks/gripper.yaml] [--steps 4800] [--chunk 120] [--json out.json]
+    python benchmarks/bench_world.py [--task robocfg/data/tasks/gripper.yaml] [--steps 4800] [--chunk 120] [--json out.json]
 
 Both loops run in the same World (same robot, drives, mimic gears, objects), interleaved in chunks
 of ``--chunk`` steps so that load from other processes hits both alike; the overhead is the median
@@ -65,7 +65,7 @@ def bench_process(args: list[str], repeats: int = 2) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--task", type=Path, default=ROOT / "tasks" / "gripper.yaml")
+    ap.add_argument("--task", type=Path, default=ROOT / "robocfg" / "data" / "tasks" / "gripper.yaml")
     ap.add_argument("--steps", type=int, default=4800)
     ap.add_argument("--chunk", type=int, default=120)
     ap.add_argument("--json", type=Path, default=None)

@@ -190,7 +190,7 @@ def test_attachment_errors_have_yaml_lines(files, gripper, mount, where, needle)
 
 
 def test_shipped_ur5e_composition():
-    robot = load_robot(ROOT / "robots" / "ur5e_robotiq_2f85.yaml")
+    robot = load_robot(ROOT / "robocfg" / "data" / "robots" / "ur5e_robotiq_2f85.yaml")
     u = robot.urdf
     assert {"robotiq_2f_85_base_link", "finger_joint", "left_inner_finger_pad", "tool0"} <= set(u.links) | set(u.joints)
     assert robot.mimic_followers(["finger_joint"]) == [

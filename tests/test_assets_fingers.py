@@ -21,7 +21,7 @@ from robocfg.checks import load_robot
 from robocfg.config.types import AXIS_INDEX
 
 ROOT = Path(__file__).resolve().parent.parent
-UR5E = ROOT / "robots" / "ur5e_robotiq_2f85.yaml"
+UR5E = ROOT / "robocfg" / "data" / "robots" / "ur5e_robotiq_2f85.yaml"
 
 
 def _curve(path: Path):

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 from robocfg.checks import load_robot, load_task
+from robocfg.config.overrides import ROBOT_OVERRIDE_SOURCE
 from robocfg.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent
-PANDA = (ROOT / "robots" / "panda.yaml").read_text()
+PANDA = (ROOT / "robocfg" / "data" / "robots" / "panda.yaml").read_text()
 DATA = ROOT / "tests" / "data"
 JI = "    joint_indices: [0, 1, 2, 3, 4, 5, 6]\n"
 R_PANDA = "R_ee_graspnet: [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]"
@@ -41,7 +42,7 @@ def errors(path: Path, strict: bool = False) -> dict[str, str]:
 
 
 def test_panda_is_valid_without_warnings():
-    robot = load_robot(ROOT / "robots" / "panda.yaml", strict=True)
+    robot = load_robot(ROOT / "robocfg" / "data" / "robots" / "panda.yaml", strict=True)
     arm = robot.config.arm()
     assert robot.warnings == []
     assert robot.arm_joints(arm) == [f"panda_joint{i}" for i in range(1, 8)]
@@ -125,7 +126,7 @@ def test_R_within_tolerance_is_accepted(tmp_path):
 
 def test_R_ee_graspnet_convention_for_panda():
     """world_R_ee = world_R_grasp · R_ee_graspnet: the grasp x (approach) is the hand's +z."""
-    robot = load_robot(ROOT / "robots" / "panda.yaml")
+    robot = load_robot(ROOT / "robocfg" / "data" / "robots" / "panda.yaml")
     R = np.asarray(robot.config.arm().R_ee_graspnet)
     world_R_grasp = np.eye(3)  # approach along world x, closing along world y
     world_R_ee = world_R_grasp @ R
@@ -251,7 +252,9 @@ def test_task_robot_override(tmp_path, monkeypatch):
     assert load_task(f).robots[0].config.name == "panda"
     assert load_task(f, robot_override="other").robots[0].config.name == "other"
     [p] = task_errors(f, robot_override="othr")
-    assert p.path == "robots[0].robot" and "did you mean 'other'?" in p.message
+    # blamed on the name given, not on the file's robot line that it replaces
+    assert (p.file, p.line, p.path) == (ROBOT_OVERRIDE_SOURCE, None, "othr")
+    assert p.message.startswith("unknown robot; did you mean 'other'?")
 
 
 def test_task_nested_robot_problems_keep_their_own_file(tmp_path):
@@ -263,7 +266,7 @@ def test_task_nested_robot_problems_keep_their_own_file(tmp_path):
 
 
 def pick_place_text() -> str:
-    return (DATA / "task_pick_place.yaml").read_text().replace("../../robots/panda.yaml", str(ROOT / "robots" / "panda.yaml"))
+    return (DATA / "task_pick_place.yaml").read_text().replace("../../robocfg/data/robots/panda.yaml", str(ROOT / "robocfg" / "data" / "robots" / "panda.yaml"))
 
 
 def test_pick_place_checks(tmp_path):
@@ -273,7 +276,7 @@ def test_pick_place_checks(tmp_path):
     assert p.path == "pick_place.object.size" and "90.0 mm" in p.message
     rotated_ok = write(tmp_path, text.replace("size: [0.04, 0.04, 0.04]", "size: [0.2, 0.05, 0.04]"), "long.yaml")
     load_task(rotated_ok)  # 5 cm across its narrow side fits an 8 cm gripper
-    nogrip = write(tmp_path, text.replace(f"robot_config_file: {ROOT / 'robots' / 'panda.yaml'}", f"robot_config_file: {DATA / 'panda_no_gripper.yaml'}"), "ng.yaml")
+    nogrip = write(tmp_path, text.replace(f"robot_config_file: {ROOT / 'robocfg' / 'data' / 'robots' / 'panda.yaml'}", f"robot_config_file: {DATA / 'panda_no_gripper.yaml'}"), "ng.yaml")
     [p] = task_errors(nogrip)
     assert p.path == "robots[0]" and "no gripper" in p.message
 

@@ -42,7 +42,7 @@ def test_every_field_is_documented(kind, roots):
 def test_worked_example_is_the_shipped_panda():
     doc = (DOCS / "robot-yaml.md").read_text()
     [example] = [b for b in re.findall(r"```yaml\n(.*?)```", doc, re.S) if "name: panda" in b]
-    assert example == (ROOT / "robots" / "panda.yaml").read_text()
+    assert example == (ROOT / "robocfg" / "data" / "robots" / "panda.yaml").read_text()
 
 
 def test_docs_state_the_conventions():

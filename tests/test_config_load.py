@@ -97,7 +97,7 @@ def test_format_loc():
 
 
 def _panda_text() -> str:
-    return (ROOT / "robots" / "panda.yaml").read_text()
+    return (ROOT / "robocfg" / "data" / "robots" / "panda.yaml").read_text()
 
 
 def test_pydantic_error_points_at_the_value_line():

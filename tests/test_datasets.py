@@ -27,7 +27,7 @@ FPS = 10  # divides the 240 Hz physics rate; fewer rendered frames keep the test
 
 def _task_file(tmp: Path, depth: bool) -> Path:
     """The shipped pick-place task with 32x32 cameras (a wrist camera with depth when asked)."""
-    doc = yaml.safe_load((ROOT / "tasks/pick_place.yaml").read_text())
+    doc = yaml.safe_load((ROOT / "robocfg/data/tasks/pick_place.yaml").read_text())
     for cam in doc["cameras"]:
         cam["width"] = cam["height"] = 32
     doc["cameras"][1]["depth"] = depth
@@ -186,7 +186,7 @@ def test_cli_dataset_info_and_errors(lerobot_ds, tmp_path, capsys, monkeypatch):
 
 
 def test_keep_success_drops_failures_and_keep_all_labels_them(tmp_path, capsys, monkeypatch):
-    doc = yaml.safe_load((ROOT / "tasks/pick_place.yaml").read_text())
+    doc = yaml.safe_load((ROOT / "robocfg/data/tasks/pick_place.yaml").read_text())
     doc.pop("cameras")
     doc["pick_place"]["timeouts"] = {"lift": 0.1}  # the lift move needs longer: the episode fails there
     task = tmp_path / "failing_lift.yaml"

@@ -1,4 +1,4 @@
-"""Grasp-frame conversion (design.md §3): the one formula every grasping command uses."""
+"""Grasp-frame conversion: the one formula every grasping command uses."""
 
 import numpy as np
 import pytest

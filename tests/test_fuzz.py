@@ -21,10 +21,10 @@ from robocfg.config.load import detect_kind, load_yaml
 from robocfg.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent
-PANDA = yaml.safe_load((ROOT / "robots" / "panda.yaml").read_text())
+PANDA = yaml.safe_load((ROOT / "robocfg" / "data" / "robots" / "panda.yaml").read_text())
 PANDA["urdf"] = "pybullet_data://franka_panda/panda.urdf"
 TASK = yaml.safe_load((ROOT / "tests" / "data" / "task_pick_place.yaml").read_text())
-TASK["robots"][0]["robot_config_file"] = str(ROOT / "robots" / "panda.yaml")
+TASK["robots"][0]["robot_config_file"] = str(ROOT / "robocfg" / "data" / "robots" / "panda.yaml")
 
 FIELD_NAMES = sorted({
     "schema_version", "name", "urdf", "arms", "joints", "joint_indices", "ee_link", "base_link",

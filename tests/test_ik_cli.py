@@ -56,7 +56,7 @@ def test_ik_bad_input_exits_2(args, capsys, monkeypatch) -> None:
 
 def test_bench_ik_writes_rows(tmp_path, capsys, monkeypatch) -> None:
     report = tmp_path / "bench.json"
-    code, out, _ = run_main(["bench", "ik", "--robot", "panda", "--n", "5", "--backends", "lm",
+    code, out, _ = run_main(["bench", "ik", "--robot", "panda", "-n", "5", "--backends", "lm",
                              "--json", str(report)], capsys, monkeypatch)
     assert code == 0, out
     data = json.loads(report.read_text())

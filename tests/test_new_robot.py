@@ -27,7 +27,7 @@ def test_panda_draft_matches_the_shipped_yaml(tmp_path, capsys, monkeypatch):
     draft_path = tmp_path / "robots" / "panda.yaml"
     draft = load_robot(draft_path)  # the draft validates without errors
     assert draft.warnings == []
-    got, want = draft.config.arms[0], load_robot(ROOT / "robots" / "panda.yaml").config.arms[0]
+    got, want = draft.config.arms[0], load_robot(ROOT / "robocfg" / "data" / "robots" / "panda.yaml").config.arms[0]
     assert got.joints == want.joints
     assert (got.base_link, got.ee_link, got.ee_axis) == (want.base_link, want.ee_link, want.ee_axis)
     assert got.tcp_offset == pytest.approx(want.tcp_offset, abs=0.002)

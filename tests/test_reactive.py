@@ -19,7 +19,7 @@ DT = 1.0 / 240.0
 
 @pytest.fixture(scope="module")
 def panda():
-    return load_robot(ROOT / "robots" / "panda.yaml")
+    return load_robot(ROOT / "robocfg" / "data" / "robots" / "panda.yaml")
 
 
 def _spec(panda):

@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _task(tmp_path: Path, follow: dict, name: str = "ft.yaml") -> Path:
     doc = {"schema_version": 1, "task": "follow_target",
-           "robots": [{"robot_config_file": str(ROOT / "robots" / "panda.yaml")}],
+           "robots": [{"robot_config_file": str(ROOT / "robocfg" / "data" / "robots" / "panda.yaml")}],
            "scene": {"ground": True}, "sim": {"timestep": 1 / 240}, "follow_target": follow}
     path = tmp_path / name
     path.write_text(yaml.safe_dump(doc))

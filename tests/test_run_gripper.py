@@ -17,7 +17,7 @@ CUBE = {"name": "cube", "shape": "box", "size": [0.04, 0.04, 0.04], "mass": 0.1,
 
 
 def test_default_task_closes_opens_and_holds(tmp_path):
-    res = run_gripper(load_task(ROOT / "tasks" / "gripper.yaml"))
+    res = run_gripper(load_task(ROOT / "robocfg" / "data" / "tasks" / "gripper.yaml"))
     assert res.success and res.robot == "panda"
     assert res.width_change >= 0.8 * (res.max_width - res.min_width)
     assert res.final_closed_width < 0.003 and res.final_open_width > 0.07
@@ -31,7 +31,7 @@ def test_default_task_closes_opens_and_holds(tmp_path):
 
 def test_direct_mode_two_cycles_without_object(tmp_path):
     extra = {"gripper": {"cycles": 2, "mode": "direct", "hold_time": 0.8}}
-    res = run_gripper(make_task(tmp_path, ROOT / "robots" / "panda.yaml", extra=extra))
+    res = run_gripper(make_task(tmp_path, ROOT / "robocfg" / "data" / "robots" / "panda.yaml", extra=extra))
     assert res.success and res.hold is None
     assert [m.phase for m in res.moves] == ["close", "open", "close", "open"]
 
@@ -39,7 +39,7 @@ def test_direct_mode_two_cycles_without_object(tmp_path):
 def test_slippery_heavy_object_fails_in_hold_phase(tmp_path):
     heavy = {**CUBE, "mass": 3.0, "friction": 0.05}
     extra = {"gripper": {"hold_object": "cube", "lift_support_by": 0.05, "mode": "direct", "hold_time": 0.4}}
-    task = make_task(tmp_path, ROOT / "robots" / "panda.yaml", objects=[heavy], extra=extra)
+    task = make_task(tmp_path, ROOT / "robocfg" / "data" / "robots" / "panda.yaml", objects=[heavy], extra=extra)
     with pytest.raises(RunFailed) as info:
         run_gripper(task)
     exc = info.value
@@ -77,7 +77,7 @@ def test_cli_ok_json_and_png(tmp_path):
 def test_cli_failure_exit_1_with_phase_and_report(tmp_path):
     heavy = {**CUBE, "mass": 3.0, "friction": 0.05}
     extra = {"gripper": {"hold_object": "cube", "mode": "direct", "hold_time": 0.4}}
-    make_task(tmp_path, ROOT / "robots" / "panda.yaml", objects=[heavy], extra=extra, name="slip.yaml")
+    make_task(tmp_path, ROOT / "robocfg" / "data" / "robots" / "panda.yaml", objects=[heavy], extra=extra, name="slip.yaml")
     out = _cli(str(tmp_path / "slip.yaml"), "--json", str(tmp_path / "r.json"), "-q", cwd=tmp_path)
     assert out.returncode == 1
     both = out.stdout + out.stderr  # the -q result line names the phase, printed once
@@ -87,7 +87,7 @@ def test_cli_failure_exit_1_with_phase_and_report(tmp_path):
 
 
 def test_cli_wrong_task_kind_is_invalid_input(tmp_path):
-    make_task(tmp_path, ROOT / "robots" / "panda.yaml", task="trajectory", name="traj.yaml")
+    make_task(tmp_path, ROOT / "robocfg" / "data" / "robots" / "panda.yaml", task="trajectory", name="traj.yaml")
     out = _cli(str(tmp_path / "traj.yaml"), cwd=tmp_path)
     assert out.returncode == 2 and "task: gripper" in out.stderr
 

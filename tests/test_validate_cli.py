@@ -107,7 +107,7 @@ def test_validate_good_test_files(capsys, monkeypatch):
 
 def test_validate_json_report(tmp_path, capsys, monkeypatch):
     out_json = tmp_path / "report.json"
-    code, _, _ = run_main(["validate", "robots/panda.yaml", "tests/data/panda_off_tcp.yaml", "--json", str(out_json)],
+    code, _, _ = run_main(["validate", "robocfg/data/robots/panda.yaml", "tests/data/panda_off_tcp.yaml", "--json", str(out_json)],
                           capsys, monkeypatch)
     assert code == 0
     report = json.loads(out_json.read_text())
@@ -150,7 +150,7 @@ def test_robots_lists_panda(tmp_path, capsys, monkeypatch):
 
 def test_robots_finds_robocfg_path(tmp_path, capsys, monkeypatch):
     (tmp_path / "robots").mkdir()
-    text = (ROOT / "robots" / "panda.yaml").read_text().replace("name: panda", "name: mypanda")
+    text = (ROOT / "robocfg" / "data" / "robots" / "panda.yaml").read_text().replace("name: panda", "name: mypanda")
     (tmp_path / "robots" / "mypanda.yaml").write_text(text.replace("../../../docs", str(ROOT / "docs")))
     monkeypatch.setenv("ROBOCFG_PATH", str(tmp_path))
     code, out, _ = run_main(["robots"], capsys, monkeypatch)
@@ -253,7 +253,7 @@ def test_schema_robot_is_valid_json_schema_and_accepts_panda(capsys, monkeypatch
     schema = json.loads(out)
     Draft202012Validator.check_schema(schema)
     validator = Draft202012Validator(schema)
-    panda = yaml.safe_load((ROOT / "robots" / "panda.yaml").read_text())
+    panda = yaml.safe_load((ROOT / "robocfg" / "data" / "robots" / "panda.yaml").read_text())
     assert list(validator.iter_errors(panda)) == []
     for bad in ("robot_ee_axis_w", "robot_unknown_key_ee_lnk", "robot_tcp_zero"):  # editors flag these too
         assert list(validator.iter_errors(yaml.safe_load((BAD / f"{bad}.yaml").read_text())))
@@ -268,7 +268,7 @@ def test_schema_task_is_valid_json_schema_and_accepts_tasks(capsys, monkeypatch)
     schema = json.loads(out)
     Draft202012Validator.check_schema(schema)
     validator = Draft202012Validator(schema)
-    tasks = [*sorted((ROOT / "tasks").glob("*.yaml")), DATA / "task_gripper.yaml", DATA / "task_pick_place.yaml"]
+    tasks = [*sorted((ROOT / "robocfg" / "data" / "tasks").glob("*.yaml")), DATA / "task_gripper.yaml", DATA / "task_pick_place.yaml"]
     for f in tasks:
         assert list(validator.iter_errors(yaml.safe_load(f.read_text()))) == [], f
     assert list(validator.iter_errors(yaml.safe_load((BAD / "task_wrong_task.yaml").read_text())))
@@ -285,7 +285,7 @@ def test_schema_output_refuses_to_overwrite_without_force(tmp_path, capsys, monk
 
 def test_shipped_yamls_point_at_the_schema():
     for kind, folder in (("robot", "robots"), ("task", "tasks")):
-        for f in sorted((ROOT / folder).glob("*.yaml")):
+        for f in sorted((ROOT / "robocfg" / "data" / folder).glob("*.yaml")):
             first = f.read_text().splitlines()[0]
             assert first.startswith("# yaml-language-server: $schema="), f
             target = (f.resolve().parent / first.split("$schema=", 1)[1]).resolve()

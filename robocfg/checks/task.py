@@ -15,7 +15,7 @@ from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
-from robocfg.config.overrides import apply_overrides, blame_overrides, parse_key
+from robocfg.config.overrides import ROBOT_OVERRIDE_SOURCE, apply_overrides, blame_overrides, parse_key
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
 from robocfg.errors import ConfigError, NotFound, Problem
@@ -158,9 +158,17 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
                     continue
             robots.append(load_robot(rpath, strict=strict))
         except NotFound as exc:
-            problems.append(doc.problem(loc, str(exc)))
+            if i == 0 and robot_override is not None:  # the name the caller gave, not the file, is wrong
+                problems.append(Problem(ROBOT_OVERRIDE_SOURCE, None, None, robot_override,
+                                        f"unknown robot{did_you_mean(exc.name, exc.known)}; known: {', '.join(sorted(exc.known))}"))
+            else:
+                problems.append(doc.problem(loc, str(exc)))
         except ConfigError as exc:
-            problems.append(doc.problem(loc, f"robot {mount.robot or mount.robot_config_file!r} is invalid ({len(exc.problems)} problem(s) below)"))
+            what = f"robot {mount.robot or mount.robot_config_file!r} is invalid ({len(exc.problems)} problem(s) below)"
+            if i == 0 and robot_override is not None:
+                problems.append(Problem(ROBOT_OVERRIDE_SOURCE, None, None, robot_override, what))
+            else:
+                problems.append(doc.problem(loc, what))
             problems.extend(exc.problems)
     warnings: list[Problem] = []
     if not problems:

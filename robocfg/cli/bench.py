@@ -14,7 +14,7 @@ bench_app = typer.Typer(help="Benchmarks measured side by side with a reference.
 @bench_app.command("ik")
 def bench_ik(
     robot: Annotated[str, typer.Option("--robot", "-r", help="Robot name or robot YAML path.")] = "panda",
-    n: Annotated[int, typer.Option("--n", help="Number of random targets.", min=1)] = 1000,
+    n: Annotated[int, typer.Option("--targets", "-n", help="Number of random targets.", min=1)] = 1000,
     backends: Annotated[str, typer.Option("--backends", help="'all' or comma-separated backend names.")] = "all",
     budget_ms: Annotated[float, typer.Option("--budget-ms", help="Time budget per query (ms).", min=0.1)] = 5.0,
     frame: Annotated[str, typer.Option("--frame", help="Target frame: ee (TRAC-IK's protocol) or tcp.")] = "ee",
@@ -24,8 +24,9 @@ def bench_ik(
     no_pybullet: Annotated[bool, typer.Option("--no-pybullet", help="Skip the PyBullet reference row.")] = False,
     json_path: JsonOpt = None,
 ) -> None:
-    """TRAC-IK's protocol: N configurations uniform within limits, targets = FK, seed = mid-limits,
-    success = 1e-5 m and 1e-5 rad and within limits, times include failures."""
+    """IK success rate and time per query, each backend beside PyBullet's IK. TRAC-IK's protocol:
+    N configurations uniform within limits, targets = FK, seed = mid-limits, success = 1e-5 m and
+    1e-5 rad and within limits, times include failures."""
     from rich.table import Table
 
     from robocfg.checks import load_robot

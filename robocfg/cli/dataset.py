@@ -33,7 +33,7 @@ def info(path: DirArg, json_path: JsonOpt = None) -> int:
 def replay(path: DirArg,
            episode: Annotated[int, typer.Option("--episode", "-e", min=0, help="Episode position in the dataset (0-based).")] = 0,
            json_path: JsonOpt = None) -> int:
-    """Re-simulate one episode from its recorded actions; exit 0 when the outcome matches (same
+    """Re-simulate one episode from its recorded actions. Exit 0 when the outcome matches (same
     success, object final position within 1 mm), 1 otherwise."""
     from robocfg.sim.quiet import quiet_import
 

@@ -47,7 +47,7 @@ def _target(position: tuple[float, float, float], euler_deg: tuple[float, float,
 def ik(
     robot: Annotated[str, typer.Argument(help="Robot name or robot YAML path.")],
     position: Annotated[tuple[float, float, float], typer.Option("--position", help="Target position X Y Z (m).")],
-    euler_deg: Annotated[tuple[float, float, float] | None, typer.Option("--euler-deg", help="Roll pitch yaw (deg), R = Rz·Ry·Rx.")] = None,
+    euler_deg: Annotated[tuple[float, float, float] | None, typer.Option("--euler-deg", metavar="R P Y", help="Roll pitch yaw (deg), R = Rz·Ry·Rx.")] = None,
     quat_xyzw: Annotated[tuple[float, float, float, float] | None, typer.Option("--quat-xyzw", help="Unit quaternion x y z w.")] = None,
     frame: Annotated[str, typer.Option("--frame", help="tcp, ee (the ee_link) or any link name.")] = "tcp",
     backend: Annotated[str | None, typer.Option("--backend", help="IK backend (default: the robot YAML's ik_backend).")] = None,
@@ -57,7 +57,7 @@ def ik(
     json_path: JsonOpt = None,
     quiet: QuietOpt = False,
 ) -> None:
-    """Solve inverse kinematics for one target pose; exit 1 if it does not converge."""
+    """Solve inverse kinematics for one target pose. Exit 1 if it does not converge."""
     import math
 
     from robocfg.checks import load_robot

@@ -14,7 +14,8 @@ def inspect(
     target: Annotated[str, typer.Argument(help="Robot name, robot YAML, or a URDF file.")],
     json_path: JsonOpt = None,
 ) -> None:
-    """Print the joint table (DOF index, PyBullet index, type, limits, mimic) and EE-link candidates."""
+    """Print a robot's joint table and EE-link candidates. Each joint with its DOF index, PyBullet
+    index, type, limits and mimic."""
     from rich.table import Table
 
     from robocfg.assets.inspection import inspect_urdf

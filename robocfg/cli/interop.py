@@ -31,8 +31,8 @@ def import_interndata(
                                                     "optional when the file has a robocfg: block.")] = None,
     force: ForceOpt = False,
 ) -> None:
-    """Map an InternDataEngine robot config onto a robocfg robot YAML, list what was dropped and why,
-    and validate the result. Errors point at lines of THEIR file. Exit 0 written, 2 invalid."""
+    """Convert an InternDataEngine robot config into a robocfg robot YAML. Lists what was dropped
+    and why, and validates the result. Errors point at lines of THEIR file. Exit 0 written, 2 invalid."""
     from robocfg.interop.interndata_import import import_interndata as convert
 
     _refuse_overwrite(output, force)
@@ -55,8 +55,8 @@ def export_interndata(
     output: OutputOpt,
     force: ForceOpt = False,
 ) -> None:
-    """Write a validated robocfg robot as an InternDataEngine robot config, with their checklist
-    items that robocfg verified marked in a comment block. Exit 0 written, 2 invalid robot."""
+    """Write a robocfg robot as an InternDataEngine robot config. The robot is validated first; the
+    items of their checklist that robocfg verified are marked in a comment block. Exit 0 written, 2 invalid robot."""
     from robocfg.checks import load_robot
     from robocfg.config import catalog
     from robocfg.interop.interndata_export import export_interndata as convert

@@ -15,20 +15,24 @@ from robocfg.cli.common import console
 
 def new_robot(
     urdf: Annotated[Path, typer.Argument(help="The robot's URDF file, or a YAML with `urdf` and `attachments` (a composed robot).", dir_okay=False)],
-    output: Annotated[Path | None, typer.Option("--output", "-o", help="Robot YAML to write (default: robots/<URDF stem>.yaml).", dir_okay=False)] = None,
+    output: Annotated[Path | None, typer.Option("--output", "-o", help="Robot YAML to write (default: robots/<URDF stem>.yaml, the folder robocfg searches first).", dir_okay=False)] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite the output file if it exists.")] = False,
 ) -> None:
-    """Write a draft robot YAML from a URDF, or from a URDF plus attachments (arm chain, gripper,
-    EE link, TCP, R_ee_graspnet, a home pose found by IK with the tool down), validate it and print
-    what a person must still check. Exit 1 if the draft does not validate."""
+    """Draft a robot YAML from a URDF, or from a URDF plus attachments. Arm chain, gripper, EE
+    link, TCP, R_ee_graspnet and a home pose found by IK with the tool down; the draft is validated
+    and what a person must still check is printed. Exit 1 if the draft does not validate."""
     from robocfg.assets.draft import render_yaml
     from robocfg.checks import load_robot
+    from robocfg.config import catalog
     from robocfg.errors import ConfigError, RobocfgError
 
     if not urdf.is_file():
         raise RobocfgError(f"URDF not found: {urdf}")
     name = re.sub(r"[^A-Za-z0-9_\-]", "_", (output.stem if output else urdf.stem))
     out_path = output or Path("robots") / f"{name}.yaml"
+    if out_path.resolve().is_relative_to(catalog.BUILTIN_DIR):
+        raise typer.BadParameter(f"{str(out_path)!r} is inside the package's built-in robots; write your robot "
+                                 "to ./robots (found by name from there) or any other folder", param_hint="--output")
     if out_path.exists() and not force:
         raise RobocfgError(f"{out_path} exists; pass --force to overwrite it")
     draft = _draft(urdf, name, out_path.parent)

@@ -18,7 +18,8 @@ def schema(
     markdown: Annotated[bool, typer.Option("--markdown", help="Field reference tables (Markdown) instead of JSON Schema; "
                                            "with -o, replaces only the generated block of an existing document.")] = False,
 ) -> None:
-    """Print the JSON Schema of robot or task YAMLs (for yaml-language-server), or of a run's --json report."""
+    """Print the JSON Schema of robot or task YAMLs, or of a run report. The YAML schemas are what
+    yaml-language-server reads to check files in an editor; a report schema describes --json."""
     from robocfg.errors import NotFound
 
     reports = report_kinds()

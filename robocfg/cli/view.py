@@ -18,7 +18,8 @@ def view(
     host: Annotated[str, typer.Option("--host", help="Browser viewer: address to bind (0.0.0.0 exposes it).")] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", help="Browser viewer: port.", min=1, max=65535)] = 8080,
 ) -> None:
-    """Show a robot (or a task's scene) with its base, ee_link, TCP and grasp frames, ee_axis and finger pads."""
+    """Show a robot, or a task's scene, with its frames. Base, ee_link, TCP and grasp frames,
+    ee_axis and finger pads; in the browser, or as a PNG sheet with --png."""
     from robocfg.cli.ik import _parse_floats
     from robocfg.viewer.source import find_source
 

@@ -164,7 +164,7 @@ class PickPlaceRandomize(Frozen):
 
 
 class PhaseTimeouts(Frozen):
-    """Per-phase time limits (s), the seed's ``events_dt`` as durations."""
+    """Per-phase time limits (s): how long each phase may take before the episode fails in it."""
 
     pre_grasp: PositiveFloat = 4.0
     approach: PositiveFloat = 3.0

@@ -18,6 +18,7 @@ from robocfg.errors import ConfigError, Problem
 from robocfg.suggest import did_you_mean
 
 OVERRIDE_SOURCE = "override"  # the "file" an override's problems are reported against
+ROBOT_OVERRIDE_SOURCE = "robot override"  # ... and a replaced first robot's (``robot=``, ``--robot``)
 
 
 def parse_key(key: str) -> Loc:

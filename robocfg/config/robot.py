@@ -47,7 +47,7 @@ class ParallelGripperConfig(Frozen):
     state_threshold: Annotated[float, Field(gt=0, lt=1)] = Field(
         0.9,
         description="Fraction of the closed→open travel above which the state is open (1.0), else closed (-1.0); "
-        "0.9 makes any grasp read as closed, as seed 004's 'open only when (nearly) fully open'.",
+        "0.9 makes any grasp read as closed: the gripper counts as open only when (nearly) fully open.",
     )
     lateral_friction: PositiveFloat = Field(1.0, description="Friction coefficient given to the finger links.")
 
@@ -166,7 +166,7 @@ class Drives(Frozen):
 
 
 class Physics(Frozen):
-    """Solver settings (seed 004's solver counts mapped to PyBullet)."""
+    """PyBullet solver settings: solver iterations, self-collision, link-mass overrides."""
 
     solver_iterations: Annotated[int, Field(ge=1, le=10000)] = Field(150, description="PyBullet numSolverIterations.")
     self_collision: bool = Field(True, description="Enable self-collision (parents excluded, finger linkage filtered).")

@@ -1,6 +1,6 @@
 """Stop at every waypoint: straight joint-space segments, each a synchronised trapezoid.
 
-This is Isaac Sim's ``to_minimal_time_joint_trajectory`` semantics (the seed's baseline): every
+This is Isaac Sim's ``to_minimal_time_joint_trajectory`` semantics (the usual baseline): every
 segment starts and ends at rest, all joints start and stop together and move along the straight
 line between the waypoints. On a straight line from rest to rest, a trapezoidal (or triangular)
 profile of the line parameter u ∈ [0, 1] with u̇ ≤ min_i v_i/|Δq_i| and |ü| ≤ min_i a_i/|Δq_i| is

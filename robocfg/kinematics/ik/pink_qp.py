@@ -2,8 +2,8 @@
 
 Each iteration solves ``min ‖J Δq + e‖²_W + posture`` subject to configuration limits and
 velocity limits (``dt`` = 1 s, so one iteration moves at most one second of joint travel), then
-integrates. The posture task pulls towards the seed (elbow-up regularisation, as in seed 000's
-PINK controller) until the frame error drops below 1 mm / 0.01 rad, after which the frame task
+integrates. The posture task pulls towards the seed configuration (it keeps an elbow-up seed's
+solution elbow-up) until the frame error drops below 1 mm / 0.01 rad, after which the frame task
 alone finishes the job to the tolerance. Stalled descents restart within the time budget.
 
 pink is imported when the solver is built.

@@ -1,0 +1,119 @@
+"""One consistent CLI: readable help, `tasks` and `robots` listings, errors blamed on what was
+typed, and a source checkout whose ./robots is the user's folder (not the built-ins)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pybullet_data
+import typer.main
+from _cli import run_main
+
+from robocfg.cli.app import app
+from robocfg.cli.help_style import first_sentence
+from robocfg.config import catalog
+
+ROOT = Path(__file__).resolve().parent.parent
+PANDA_URDF = Path(pybullet_data.getDataPath()) / "franka_panda" / "panda.urdf"
+
+
+def _commands(group, prefix=()):
+    for name, cmd in group.commands.items():
+        yield (*prefix, name), cmd
+        if hasattr(cmd, "commands"):
+            yield from _commands(cmd, (*prefix, name))
+
+
+def test_every_help_has_readable_placeholders_and_whole_summaries(capsys, monkeypatch):
+    root = typer.main.get_command(app)
+    paths = [p for p, _ in _commands(root)]
+    assert ("tasks",) in paths and ("run", "pick-place") in paths and ("bench", "ik") in paths
+    for path in [(), *paths]:
+        code, out, _ = run_main([*path, "--help"], capsys, monkeypatch)
+        assert code == 0, path
+        # no Python type names as placeholders, no summary cut short
+        assert not re.search(r"<[a-z][\w\[\], ]*>", out), (path, out)
+        assert "..." not in out.replace("[ARGS]...", "").replace("`run ... --dataset`", "").replace("]...", ""), (path, out)
+    code, out, _ = run_main(["ik", "--help"], capsys, monkeypatch)
+    assert "--position X Y Z" in out and "--euler-deg R P Y" in out and "--quat-xyzw X Y Z W" in out
+    assert "--budget-ms X" in out and "ROBOT  " in out
+    code, out, _ = run_main(["validate", "--help"], capsys, monkeypatch)
+    assert "[PATHS]..." in out and "--json PATH" in out
+
+
+def test_summary_is_the_first_sentence_whole():
+    assert first_sentence("Draft a robot YAML from a URDF. Then more.") == "Draft a robot YAML from a URDF."
+    assert first_sentence("Inspect datasets written by `run ... --dataset`.") == \
+        "Inspect datasets written by `run ... --dataset`."
+    assert first_sentence("Spans\n  two lines, e.g. this. Rest.") == "Spans two lines, e.g. this."
+
+
+def test_shell_completion_is_offered(capsys, monkeypatch):
+    code, out, _ = run_main(["--help"], capsys, monkeypatch)
+    assert code == 0 and "--install-completion" in out and "--show-completion" in out
+
+
+def test_tasks_lists_every_task_with_kind_robot_and_command(capsys, monkeypatch, tmp_path):
+    out_json = tmp_path / "tasks.json"
+    code, out, _ = run_main(["tasks", "--json", str(out_json)], capsys, monkeypatch)
+    assert code == 0
+    entries = {e["name"]: e for e in json.loads(out_json.read_text())}
+    assert set(entries) == set(catalog.available("tasks"))
+    pp = entries["pick_place"]
+    assert (pp["kind"], pp["robots"], pp["valid"]) == ("pick_place", ["panda"], True)
+    assert pp["command"] == "robocfg run pick-place pick_place" and pp["description"]
+    assert entries["pick_place_kuka_kr210"]["robots"] == ["kuka_kr210"]
+    assert "pick_place_kuka_kr210" in out
+
+
+def test_tasks_lists_an_invalid_user_task_as_invalid(capsys, monkeypatch, tmp_path):
+    (tmp_path / "tasks").mkdir()
+    (tmp_path / "tasks" / "mine.yaml").write_text("schema_version: 1\ntask: pick_place\nrobots: []\n")
+    code, _, _ = run_main(["tasks", "--json", str(tmp_path / "t.json")], capsys, monkeypatch, tmp_path)
+    assert code == 0
+    [mine] = [e for e in json.loads((tmp_path / "t.json").read_text()) if e["name"] == "mine"]
+    assert mine["valid"] is False and mine["problems"] >= 1 and mine["errors"]
+
+
+def test_robots_json_has_lists_and_descriptions(capsys, monkeypatch, tmp_path):
+    code, _, _ = run_main(["robots", "--json", str(tmp_path / "r.json")], capsys, monkeypatch)
+    assert code == 0
+    entries = {e["name"]: e for e in json.loads((tmp_path / "r.json").read_text())}
+    dual = entries["dual_panda"]
+    assert dual["arms"] == ["left", "right"] and dual["grippers"] == ["parallel", "parallel"]
+    assert dual["dof"] == 14 and dual["valid"] and dual["description"]
+
+
+def test_unknown_robot_option_is_blamed_on_the_option(capsys, monkeypatch):
+    code, out, err = run_main(["run", "pick-place", "--robot", "pnda"], capsys, monkeypatch)
+    assert code == 2 and "Traceback" not in out + err
+    assert err.startswith("--robot pnda: unknown robot; did you mean 'panda'?")
+    assert "pick_place.yaml" not in err
+
+
+def test_bench_ik_takes_n_like_run(capsys, monkeypatch):
+    code, out, _ = run_main(["bench", "ik", "--help"], capsys, monkeypatch)
+    assert code == 0 and "-n, --targets N" in out
+
+
+def test_checkout_robots_folder_is_the_users_not_the_builtins():
+    for folder in ("robots", "tasks"):
+        d = ROOT / folder
+        assert d.is_dir() and not d.is_symlink(), folder
+        assert not list(d.glob("*.yaml")), f"built-in YAMLs belong in robocfg/data/{folder}"
+    assert catalog.BUILTIN_DIR == ROOT / "robocfg" / "data"
+
+
+def test_new_robot_in_a_checkout_writes_to_the_users_folder(capsys, monkeypatch, tmp_path):
+    builtins_before = sorted((catalog.BUILTIN_DIR / "robots").iterdir())
+    code, _, err = run_main(["new-robot", str(PANDA_URDF), "-o", str(catalog.BUILTIN_DIR / "robots" / "x.yaml")],
+                            capsys, monkeypatch, tmp_path)
+    assert code == 2 and "--output" in err and "built-in" in err
+    assert sorted((catalog.BUILTIN_DIR / "robots").iterdir()) == builtins_before
+    code, out, _ = run_main(["new-robot", str(PANDA_URDF), "-o", "robots/my_panda.yaml"], capsys, monkeypatch, tmp_path)
+    assert code == 0, out
+    assert (tmp_path / "robots" / "my_panda.yaml").is_file()
+    monkeypatch.chdir(tmp_path)
+    assert catalog.find("robots", "my_panda").resolve() == (tmp_path / "robots" / "my_panda.yaml").resolve()
