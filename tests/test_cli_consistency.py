@@ -117,3 +117,43 @@ def test_new_robot_in_a_checkout_writes_to_the_users_folder(capsys, monkeypatch,
     assert (tmp_path / "robots" / "my_panda.yaml").is_file()
     monkeypatch.chdir(tmp_path)
     assert catalog.find("robots", "my_panda").resolve() == (tmp_path / "robots" / "my_panda.yaml").resolve()
+
+
+def test_set_changes_a_task_field_validated_like_the_file(capsys, monkeypatch, tmp_path):
+    task = str(ROOT / "robocfg" / "data" / "tasks" / "pick_place.yaml")
+    code, _, err = run_main(["validate", task, "--set", "pick_place.lift_height=0.3"], capsys, monkeypatch)
+    assert code == 0, err
+    code, _, err = run_main(["validate", task, "--set", "pick_place.lift_hight=0.3", "--set", "sim.seed=-1",
+                             "--set", "pick_place.place_position=[0.5, 0.3]", "--json", str(tmp_path / "v.json")],
+                            capsys, monkeypatch)
+    assert code == 2 and "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert "--set pick_place.lift_hight: unknown key 'lift_hight'; did you mean 'lift_height'?" in lines
+    assert any(line.startswith("--set sim.seed: ") for line in lines)
+    assert any(line.startswith("--set pick_place.place_position: ") for line in lines)
+    assert not any("pick_place.yaml:" in line for line in lines)  # the file is fine; the options are not
+    [record] = json.loads((tmp_path / "v.json").read_text())["files"]
+    assert {p["path"] for p in record["problems"]} == {"pick_place.lift_hight", "sim.seed", "pick_place.place_position"}
+
+
+def test_set_without_equals_or_with_bad_yaml_is_a_usage_error(capsys, monkeypatch):
+    for bad, expected in (("lift_height", "--set lift_height: expected KEY=VALUE"),
+                          ("pick_place.lift_height=[1,", "--set pick_place.lift_height: value '[1,' is not a YAML value")):
+        code, _, err = run_main(["validate", "pick_place.yaml", "--set", bad], capsys, monkeypatch)
+        assert code == 2 and err.startswith(expected), err
+
+
+def test_view_set_needs_a_task(capsys, monkeypatch):
+    code, _, err = run_main(["view", "panda", "--png", "x.png", "--set", "name=other"], capsys, monkeypatch)
+    assert code == 2 and err.startswith("--set: 'panda' is a robot"), err
+
+
+def test_inspect_takes_the_urdf_uris_a_robot_yaml_takes(capsys, monkeypatch, tmp_path):
+    code, _, _ = run_main(["inspect", "pybullet_data://franka_panda/panda.urdf", "--json", str(tmp_path / "i.json")],
+                          capsys, monkeypatch)
+    assert code == 0
+    info = json.loads((tmp_path / "i.json").read_text())
+    assert Path(info["urdf"]) == PANDA_URDF.resolve()
+    assert [j["name"] for j in info["joints"] if j["dof_index"] is not None][:2] == ["panda_joint1", "panda_joint2"]
+    code, _, err = run_main(["inspect", "pybullet_data://no/such.urdf"], capsys, monkeypatch)
+    assert code == 2 and "cannot resolve 'pybullet_data://no/such.urdf'" in err

@@ -127,13 +127,15 @@ def _default(o: Any) -> Any:
     raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
-def load_task_for(task: str, kind: str, command: str, robot: str | None = None):
-    """Find and check a task YAML by name or path; it must be a ``task: <kind>`` file."""
+def load_task_for(task: str, kind: str, command: str, robot: str | None = None,
+                  overrides: dict[str, Any] | None = None):
+    """Find and check a task YAML by name or path; it must be a ``task: <kind>`` file.
+    ``overrides``: fields changed by ``--set`` (see ``robocfg.cli.set_option``)."""
     from robocfg.checks import load_task
     from robocfg.config import catalog
     from robocfg.errors import ConfigError
 
-    checked = load_task(catalog.find("tasks", task), robot_override=robot)
+    checked = load_task(catalog.find("tasks", task), robot_override=robot, overrides=overrides)
     if checked.config.task != kind:
         raise ConfigError([checked.doc.problem(("task",), f"'run {command}' needs a 'task: {kind}' file, "
                                                          f"this is 'task: {checked.config.task}'")])

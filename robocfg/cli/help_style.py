@@ -18,9 +18,10 @@ import typing
 from pathlib import Path
 
 import typer.core
+from typer._click import Command  # typer's own copy of click, whose commands typer builds
 
 
-def polish(command: typer.core.TyperCommand | typer.core.TyperGroup) -> None:
+def polish(command: Command) -> None:
     """Apply the help conventions to ``command`` and every sub-command, in place."""
     if command.help and not command.short_help:
         command.short_help = first_sentence(command.help)

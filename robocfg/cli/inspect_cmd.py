@@ -11,7 +11,8 @@ from robocfg.cli.common import JsonOpt, console, write_json
 
 
 def inspect(
-    target: Annotated[str, typer.Argument(help="Robot name, robot YAML, or a URDF file.")],
+    target: Annotated[str, typer.Argument(help="Robot name, robot YAML, or a URDF: a path, pybullet_data://REL, "
+                                                "airo_models://NAME (URIs as in a robot YAML's urdf).")],
     json_path: JsonOpt = None,
 ) -> None:
     """Print a robot's joint table and EE-link candidates. Each joint with its DOF index, PyBullet
@@ -25,8 +26,8 @@ def inspect(
     from robocfg.errors import ConfigError
 
     robot = None
-    if target.endswith(".urdf"):
-        urdf_path = Path(target)
+    if target.endswith(".urdf") or "://" in target:
+        urdf_path = _resolve_urdf(target)
         try:
             urdf = parse_urdf(urdf_path)
         except UrdfParseError as exc:
@@ -54,6 +55,19 @@ def inspect(
                       f"gripper {arm.gripper.type if arm.gripper else 'none'}")
         payload["arms"] = [a.model_dump() for a in robot.config.arms]
     write_json(json_path, payload)
+
+
+def _resolve_urdf(uri: str) -> Path:
+    """The URDF file a URI names; a plain path as given (problems are reported at that name)."""
+    from robocfg.assets.paths import Resolver, UnresolvedPath
+    from robocfg.errors import RobocfgError
+
+    if "://" not in uri:
+        return Path(uri)
+    try:
+        return Resolver(Path.cwd()).urdf(uri)
+    except UnresolvedPath as exc:
+        raise RobocfgError(str(exc)) from None
 
 
 def _num(v: float, show: bool) -> str:

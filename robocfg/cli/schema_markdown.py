@@ -77,8 +77,22 @@ def _models_in(tp: Any) -> list[type[BaseModel]]:
 def _default(field: Any) -> str:
     value = field.get_default(call_default_factory=True)
     if isinstance(value, BaseModel):
-        return "see table"
+        changed = _changed_from_table(value)
+        return f"see table, with `{json.dumps(changed, ensure_ascii=False)}`" if changed else "see table"
     return f"`{json.dumps(value, ensure_ascii=False)}`" if value not in ([], {}) else f"`{json.dumps(value)}`"
+
+
+def _changed_from_table(value: BaseModel) -> dict[str, Any]:
+    """The fields in which a nested default differs from its model's own defaults (the values its
+    table lists), e.g. a region whose default here is ±8 cm although a bare region's is 0."""
+    from pydantic import ValidationError
+
+    try:
+        plain = type(value)().model_dump(mode="json")
+    except ValidationError:  # the model has required fields: its table lists no defaults for them
+        return {}
+    mine = value.model_dump(mode="json")
+    return {k: v for k, v in mine.items() if plain.get(k) != v}
 
 
 def _type(prop: dict) -> str:

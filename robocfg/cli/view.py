@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from robocfg.cli.common import console
+from robocfg.cli.set_option import SetOpt, overrides
 
 
 def view(
@@ -17,13 +18,14 @@ def view(
     collision: Annotated[bool, typer.Option("--collision", help="Also draw the links' collision shapes.")] = False,
     host: Annotated[str, typer.Option("--host", help="Browser viewer: address to bind (0.0.0.0 exposes it).")] = "127.0.0.1",
     port: Annotated[int, typer.Option("--port", help="Browser viewer: port.", min=1, max=65535)] = 8080,
+    set_: SetOpt = None,
 ) -> None:
     """Show a robot, or a task's scene, with its frames. Base, ee_link, TCP and grasp frames,
     ee_axis and finger pads; in the browser, or as a PNG sheet with --png."""
     from robocfg.cli.ik import _parse_floats
     from robocfg.viewer.source import find_source
 
-    source = find_source(target)
+    source = find_source(target, overrides(set_))
     joints = _parse_floats(q, "--q")
     if png is not None:
         from robocfg.viewer.picture import write_sheet

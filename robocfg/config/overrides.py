@@ -9,11 +9,12 @@ The Python API's ``with_overrides`` and a command line ``--set key=value`` both 
 from __future__ import annotations
 
 import copy
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
-from robocfg.config.load import Loc, YamlDocument, format_loc
+from robocfg.config.load import Loc, YamlDocument, format_loc, parse_yaml
 from robocfg.errors import ConfigError, Problem
 from robocfg.suggest import did_you_mean
 
@@ -29,6 +30,36 @@ def parse_key(key: str) -> Loc:
             raise ConfigError([Problem(OVERRIDE_SOURCE, None, None, key, "empty part in a dotted key")])
         parts.append(int(raw) if raw.lstrip("-").isdigit() else raw)
     return tuple(parts)
+
+
+def parse_assignments(items: Iterable[str]) -> dict[str, Any]:
+    """``["pick_place.lift_height=0.2", "robots.0.position=[0.1, 0, 0]"]`` → ``{key: value}``.
+
+    The value is read as a YAML value by the same reader as the files (``0.2`` and ``1e-3`` are
+    numbers, ``[0.1, 0, 0]`` a list, ``true`` a boolean, ``panda`` a string), so a value typed on a
+    command line is validated exactly like the same text in a file. A later item with the same
+    key wins. Raises ConfigError naming the item when it has no ``=`` or its value is no YAML."""
+    out: dict[str, Any] = {}
+    problems: list[Problem] = []
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            problems.append(Problem(OVERRIDE_SOURCE, None, None, item, "expected KEY=VALUE, e.g. pick_place.lift_height=0.2"))
+            continue
+        try:
+            parse_key(key)
+        except ConfigError as exc:
+            problems += exc.problems
+            continue
+        try:
+            out[key] = parse_yaml(f"value: {text.strip() or 'null'}\n", Path(key)).data["value"]
+        except ConfigError as exc:
+            problems.append(Problem(OVERRIDE_SOURCE, None, None, key, f"value {text!r} is not a YAML value: "
+                                    f"{exc.problems[0].message}"))
+    if problems:
+        raise ConfigError(problems)
+    return out
 
 
 def apply_overrides(doc: YamlDocument, overrides: Mapping[str, Any]) -> YamlDocument:

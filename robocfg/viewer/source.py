@@ -6,14 +6,16 @@ A name is looked up among the robots first, then the tasks (the search path of
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 from robocfg.checks import CheckedRobot, CheckedTask, load_robot, load_task
 from robocfg.config import catalog
 from robocfg.config.load import detect_kind, load_yaml
-from robocfg.errors import NotFound
+from robocfg.config.overrides import OVERRIDE_SOURCE
+from robocfg.errors import ConfigError, NotFound, Problem
 
 
 @dataclass(frozen=True)
@@ -22,17 +24,28 @@ class ViewSource:
 
     kind: Literal["robot", "task"]
     path: Path
+    overrides: Mapping[str, Any] = field(default_factory=dict)  # a task's changed fields (``--set``)
 
     def load(self) -> CheckedRobot | CheckedTask:
         """Load and check the file (ConfigError with FILE:LINE problems if it is invalid)."""
-        return load_robot(self.path) if self.kind == "robot" else load_task(self.path)
+        return load_robot(self.path) if self.kind == "robot" else load_task(self.path, overrides=self.overrides)
 
     def robots(self, checked: CheckedRobot | CheckedTask) -> list[CheckedRobot]:
         return [checked] if isinstance(checked, CheckedRobot) else list(checked.robots)
 
 
-def find_source(name_or_path: str) -> ViewSource:
-    """The robot or task YAML meant by ``name_or_path``."""
+def find_source(name_or_path: str, overrides: Mapping[str, Any] | None = None) -> ViewSource:
+    """The robot or task YAML meant by ``name_or_path``; ``overrides`` change a task's fields."""
+    source = _find(name_or_path)
+    if overrides:
+        if source.kind != "task":
+            raise ConfigError([Problem(OVERRIDE_SOURCE, None, None, "",
+                                       f"{name_or_path!r} is a robot; overrides change the fields of a task")])
+        return ViewSource("task", source.path, dict(overrides))
+    return source
+
+
+def _find(name_or_path: str) -> ViewSource:
     path = Path(name_or_path).expanduser()
     if path.is_file():
         kind = detect_kind(load_yaml(path))
