@@ -157,3 +157,12 @@ def test_inspect_takes_the_urdf_uris_a_robot_yaml_takes(capsys, monkeypatch, tmp
     assert [j["name"] for j in info["joints"] if j["dof_index"] is not None][:2] == ["panda_joint1", "panda_joint2"]
     code, _, err = run_main(["inspect", "pybullet_data://no/such.urdf"], capsys, monkeypatch)
     assert code == 2 and "cannot resolve 'pybullet_data://no/such.urdf'" in err
+
+
+def test_validate_takes_names_from_the_search_path(capsys, monkeypatch, tmp_path):
+    code, _, err = run_main(["validate", "pick_place", "panda", "--json", str(tmp_path / "v.json")], capsys, monkeypatch)
+    assert code == 0, err
+    files = [Path(f["file"]).resolve() for f in json.loads((tmp_path / "v.json").read_text())["files"]]
+    assert files == [catalog.find("tasks", "pick_place").resolve(), catalog.find("robots", "panda").resolve()]
+    code, _, err = run_main(["validate", "no_such_thing"], capsys, monkeypatch)
+    assert code == 2 and "no_such_thing: file not found" in err

@@ -108,5 +108,8 @@ def test_save_cloud(tmp_path, suffix):
         lines = path.read_text().splitlines()
         assert lines[0] == "ply" and "element vertex 2" in lines
         assert lines[-1].split() == ["0.400000", "0.500000", "0.600000", "1.000000", "0.000000", "0.000000", "4"]
+        import trimesh  # another PLY reader reads the file back
+
+        assert np.allclose(trimesh.load(path, process=False).vertices, cloud.points)
     with pytest.raises(ValueError):
         save_cloud(cloud, tmp_path / "c.txt")

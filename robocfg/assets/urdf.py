@@ -2,6 +2,12 @@
 
 Fast enough for ``robocfg validate`` (no trimesh, no simulator). DOF indices follow the order of
 movable joints in the file, the same order PyBullet uses for its joint indices.
+
+Why not yourdfpy (used by the browser viewer) or pinocchio: a problem in a URDF is reported at
+its line (``panda.urdf:42:``), which needs the XML parser's positions; yourdfpy imports trimesh
+(seconds of start-up for ``validate``, see ``robocfg.assets.meshes``), and pinocchio belongs to
+the kinematics layer above this one. ``Urdf.link_pose`` is the few lines of forward kinematics
+the URDF checks need (finger pads, TCP) before any kinematic model exists.
 """
 
 from __future__ import annotations

@@ -12,7 +12,8 @@ from robocfg.cli.set_option import SetOpt, overrides
 
 
 def validate(
-    paths: Annotated[list[Path] | None, typer.Argument(help="YAML files or directories; none = all built-ins.")] = None,
+    paths: Annotated[list[Path] | None, typer.Argument(
+        help="YAML files, directories, or robot/task names; none = every robot and task on the search path.")] = None,
     strict: StrictOpt = False,
     json_path: JsonOpt = None,
     set_: SetOpt = None,
@@ -67,8 +68,18 @@ def _collect(paths: list[Path]) -> list[Path]:
             found = sorted(x for x in p.rglob("*") if x.suffix in (".yaml", ".yml") and x.is_file())
             files += found or [p]
         else:
-            files.append(p)
+            files.append(p if p.exists() else _by_name(p))
     return files
+
+
+def _by_name(p: Path) -> Path:
+    """A robot or task named on the search path (``pick_place``); else ``p`` (then reported missing)."""
+    from robocfg.config import catalog
+
+    if p.suffix or len(p.parts) != 1:
+        return p
+    found = {**catalog.available("tasks"), **catalog.available("robots")}  # robots win a shared name
+    return found.get(str(p), found.get(str(p).replace("-", "_"), p))
 
 
 def _short(p: Path) -> str:

@@ -109,14 +109,14 @@ def save_cloud(cloud: Cloud, path: Path) -> Path:
         np.savez_compressed(path, points=cloud.points, normals=normals, labels=cloud.labels,
                             viewpoints=cloud.viewpoints)
     elif path.suffix.lower() == ".ply":
-        header = ["ply", "format ascii 1.0", f"element vertex {len(cloud)}", "property float x", "property float y",
-                  "property float z", "property float nx", "property float ny", "property float nz",
-                  "property int label", "end_header"]
-        rows = np.column_stack([cloud.points, normals])
-        with path.open("w") as fh:
-            fh.write("\n".join(header) + "\n")
-            for r, lab in zip(rows, cloud.labels, strict=True):
-                fh.write(" ".join(f"{v:.6f}" for v in r) + f" {int(lab)}\n")
+        # trimesh writes PLY for meshes, but not a face-less cloud with normals and a label per
+        # point (its PointCloud has no vertex attributes; export_ply fails on a Trimesh without
+        # faces), so the ASCII PLY header is written here and numpy writes the rows.
+        header = "\n".join(["ply", "format ascii 1.0", f"element vertex {len(cloud)}",
+                            *(f"property float {a}" for a in ("x", "y", "z", "nx", "ny", "nz")),
+                            "property int label", "end_header"])
+        table = np.column_stack([cloud.points, normals, cloud.labels])
+        np.savetxt(path, table, fmt=["%.6f"] * 6 + ["%d"], header=header, comments="")
     else:
         raise ValueError(f"--save-cloud needs a .npz or .ply file name, got {path.name!r}")
     return path
