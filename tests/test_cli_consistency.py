@@ -20,7 +20,9 @@ PANDA_URDF = Path(pybullet_data.getDataPath()) / "franka_panda" / "panda.urdf"
 
 
 def _commands(group, prefix=()):
-    for name, cmd in group.commands.items():
+    ctx = group.make_context(group.name, ["--help"], resilient_parsing=True)  # the run group loads lazily
+    for name in group.list_commands(ctx):
+        cmd = group.get_command(ctx, name)
         yield (*prefix, name), cmd
         if hasattr(cmd, "commands"):
             yield from _commands(cmd, (*prefix, name))
@@ -166,3 +168,25 @@ def test_validate_takes_names_from_the_search_path(capsys, monkeypatch, tmp_path
     assert files == [catalog.find("tasks", "pick_place").resolve(), catalog.find("robots", "panda").resolve()]
     code, _, err = run_main(["validate", "no_such_thing"], capsys, monkeypatch)
     assert code == 2 and "no_such_thing: file not found" in err
+
+
+def test_every_run_kind_takes_set_and_blames_it(capsys, monkeypatch):
+    from robocfg.engine.registry import command_name, registered
+
+    for kind in registered():
+        code, out, _ = run_main(["run", command_name(kind), "--help"], capsys, monkeypatch)
+        assert code == 0 and "--set KEY=VALUE" in out and "-n, --episodes N" in out, kind
+    code, out, err = run_main(["run", "pick-place", "--set", "pick_place.lift_hight=0.2", "-q"], capsys, monkeypatch)
+    assert code == 2 and "Traceback" not in out + err
+    assert err.startswith("--set pick_place.lift_hight: unknown key 'lift_hight'; did you mean 'lift_height'?")
+
+
+def test_run_set_changes_the_run(capsys, monkeypatch, tmp_path):
+    report = tmp_path / "r.json"
+    code, _, err = run_main(["run", "trajectory", "--set", "trajectory.limits.velocity_scale=0.2", "--no-sim", "-q",
+                             "--json", str(report)], capsys, monkeypatch)
+    assert code == 0, err
+    slow = json.loads(report.read_text())["duration"]
+    code, _, err = run_main(["run", "trajectory", "--no-sim", "-q", "--json", str(report)], capsys, monkeypatch)
+    assert code == 0, err
+    assert slow > 1.5 * json.loads(report.read_text())["duration"]

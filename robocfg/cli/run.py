@@ -18,6 +18,7 @@ class _KindsGroup(TyperGroup):
     def _commands(self) -> Any:
         if not self._kinds_loaded:
             from robocfg.cli import run_pick_place  # noqa: F401  (registers the dataset hook)
+            from robocfg.cli.help_style import polish
             from robocfg.cli.run_command import make_command
             from robocfg.engine.registry import command_name, registered
 
@@ -26,6 +27,7 @@ class _KindsGroup(TyperGroup):
                 fn = make_command(runner)
                 sub.command(command_name(kind), help=fn.__doc__)(fn)
                 self.commands[command_name(kind)] = typer.main.get_command(sub)
+                polish(self.commands[command_name(kind)])  # loaded after the root polished the tree
             self._kinds_loaded = True
         return self.commands
 

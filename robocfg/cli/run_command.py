@@ -2,7 +2,7 @@
 output-path checks, exit codes, SIGINT partial report and printing for every registered kind.
 
 The options every kind gets: ``TASK``, ``--robot/-r``, ``--arm``, ``--seed``, ``-n/--episodes``,
-``--json``, ``--record``, ``--record-episode``, ``--gui``, ``-q``, ``--min-success``. A kind's own
+``--json``, ``--record``, ``--record-episode``, ``--gui``, ``-q``, ``--min-success``, ``--set``. A kind's own
 options are the fields of its ``Options`` dataclass (``robocfg.engine.option``). Front-end
 additions that need the CLI's own imports (the dataset sink of pick-place) are :class:`CliHook` s.
 """
@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, SeedOpt, _output_path
+from robocfg.cli.set_option import SetOpt
 
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
@@ -56,6 +57,7 @@ def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Param
         opt("quiet", QuietOpt, False),
         opt("min_success", Annotated[float, typer.Option("--min-success", min=0.0, max=1.0,
                                                          help=f"Exit 1 when the share of episodes {verb} is below this.")], 1.0),
+        opt("set_", SetOpt, None),
     ]
 
 
@@ -128,7 +130,7 @@ def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
 
 def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm: str | None, seed: int | None,
             episodes: int, json_path: Path | None, record: Path | None, record_episode: int, gui: bool,
-            quiet: bool, min_success: float, extras: Any) -> int:
+            quiet: bool, min_success: float, extras: Any, set_: list[str] | None = None) -> int:
     """Check, run, write and print one ``run <kind>``; the exit code (0, 1 or 130)."""
     from robocfg.cli.common import console, load_task_for, write_json
     from robocfg.cli.episodes import (
@@ -138,6 +140,7 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
         stop_on_signals,
     )
     from robocfg.cli.run_print import print_report
+    from robocfg.cli.set_option import overrides
     from robocfg.engine.options import RunOptions
     from robocfg.engine.registry import command_name
     from robocfg.engine.runner import RunOutput
@@ -147,7 +150,7 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     kind = runner_type.kind
     check_record_episode(record_episode, episodes, record is not None)
     quiet_import()
-    checked = load_task_for(task, kind, command_name(kind), robot)
+    checked = load_task_for(task, kind, command_name(kind), robot, overrides(set_))
     out = console()
     log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
     options = RunOptions(seed=seed, episodes=episodes, arm=arm, gui=gui, record=record, record_episode=record_episode,

@@ -11,7 +11,7 @@ import typer
 
 
 def schema(
-    kind: Annotated[str, typer.Argument(help="robot, task, or a run report: report-<kind> (report-pick-place, "
+    kind: Annotated[str, typer.Argument(help="robot, task, or a run report: report-KIND (report-pick-place, "
                                              "report-grasp, report-gripper, report-trajectory, report-follow-target)")],
     output: Annotated[Path | None, typer.Option("-o", "--output", help="Write to this file instead of stdout.")] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing output file.")] = False,

@@ -65,8 +65,9 @@ class FollowTargetRunner(TaskRunner):
     params = FollowTargetParams
     report = FollowTargetResult
     Options = FollowTargetOptions
-    summary = ("Track a static / waypoint / circle / figure-8 target with a QP per control step (placo), keeping "
-               "the safety margin from obstacles, table and ground. With --gui, drag the target with the sliders.")
+    summary = ("Follow a moving target with the TCP, clear of obstacles. A static / waypoint / circle / figure-8 "
+               "target tracked with a QP per control step (placo), keeping the safety margin from obstacles, "
+               "table and ground. With --gui, drag the target with the sliders.")
 
     def run(self) -> RunOutput:
         o, x = self.options, self.options.extras

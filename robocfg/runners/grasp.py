@@ -130,8 +130,9 @@ class GraspRunner(EpisodicRunner):
     report = GraspReport
     Options = GraspOptions
     verb = "lifted"
-    summary = ("Perceive the object with RGB-D cameras, plan antipodal grasps on the point cloud, execute the "
-               "best, lift, shake and verify; retry the next-ranked grasp on failure.")
+    summary = ("Grasp objects with grasps planned from simulated depth cameras. Perceive the object with RGB-D "
+               "cameras, plan antipodal grasps on the point cloud, execute the best, lift, shake and verify; "
+               "retry the next-ranked grasp on failure.")
     description = (
         "Grasp → EE by R_ee_graspnet, ee_axis, tcp_offset. Episode k grasps objects[k % n]. Exit 0 when the "
         "lift success rate reaches --min-success, 1 otherwise (no object points in the workspace, no feasible "

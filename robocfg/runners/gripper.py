@@ -91,7 +91,8 @@ class GripperRunner(TaskRunner):
     kind = "gripper"
     params = GripperParams
     report = GripperResult
-    summary = "Close then open the arm's gripper; report measured widths, timing, mimic error and the hold test."
+    summary = ("Close and open the gripper, then hold a cube. Reports measured widths, timing, mimic error and "
+               "the hold test.")
 
     def check(self) -> None:
         super().check()

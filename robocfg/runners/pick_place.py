@@ -125,7 +125,8 @@ class PickPlaceRunner(EpisodicRunner):
     report = PickPlaceReport
     Options = PickPlaceOptions
     verb = "placed"
-    summary = "Pick the task's object and place it, robot-agnostic (grasp → EE by R_ee_graspnet, ee_axis, tcp_offset)."
+    summary = ("Pick the task's object and place it, on any robot. Grasp → EE by R_ee_graspnet, ee_axis, "
+               "tcp_offset.")
     description = (
         "Exit 0 when the success rate reaches --min-success (default: every episode), 1 otherwise; the "
         "--json report (one record per episode; no wall-clock figures, so the same seed gives the same "

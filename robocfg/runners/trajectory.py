@@ -135,8 +135,8 @@ class TrajectoryRunner(TaskRunner):
     params = TrajectoryParams
     report = TrajectoryResult
     Options = TrajectoryOptions
-    summary = ("Plan a time-optimal trajectory through the task's waypoints (toppra; trapezoids with "
-               "stop_at_waypoints; ruckig with a jerk limit), check it against the limits at 1 kHz, and track it "
+    summary = ("Plan a time-optimal trajectory through the task's waypoints and track it. toppra; trapezoids "
+               "with stop_at_waypoints; ruckig with a jerk limit; checked against the limits at 1 kHz, tracked "
                "in PyBullet. Prints duration, planning time, violations and tracking error.")
 
     def check(self) -> None:
