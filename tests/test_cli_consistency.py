@@ -4,7 +4,10 @@ typed, and a source checkout whose ./robots is the user's folder (not the built-
 from __future__ import annotations
 
 import json
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pybullet_data
@@ -190,3 +193,23 @@ def test_run_set_changes_the_run(capsys, monkeypatch, tmp_path):
     code, _, err = run_main(["run", "trajectory", "--no-sim", "-q", "--json", str(report)], capsys, monkeypatch)
     assert code == 0, err
     assert slow > 1.5 * json.loads(report.read_text())["duration"]
+
+
+def _complete(words: str) -> list[str]:
+    """What bash completion offers after ``words`` (the protocol the installed script speaks)."""
+    env = {**os.environ, "_ROBOCFG_COMPLETE": "complete_bash", "COMP_WORDS": words,
+           "COMP_CWORD": str(len(words.split()) - 1)}
+    script = "import sys; sys.argv[0] = 'robocfg'; from robocfg.cli.app import main; main()"
+    proc = subprocess.run([sys.executable, "-c", script], env=env, cwd=ROOT, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    return proc.stdout.split()
+
+
+def test_shell_completion_offers_task_and_robot_names():
+    tasks = _complete("robocfg run pick-place pick")
+    assert "pick_place" in tasks and "pick_place_obstacle" in tasks
+    assert all(catalog.find("tasks", t) for t in tasks)
+    assert "gripper" not in _complete("robocfg run pick-place g")  # a task of another kind
+    robots = _complete("robocfg run gripper --robot ur")
+    assert "ur5e_robotiq_2f85" in robots and all(r.startswith("ur") for r in robots)

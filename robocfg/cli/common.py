@@ -9,6 +9,8 @@ from typing import Annotated, Any
 
 import typer
 
+from robocfg.cli.completion import robot_names
+
 STDOUT = Path("-")  # ``--json -``: the report goes to standard output, the human summary to stderr
 _stdout_taken = False
 
@@ -58,7 +60,8 @@ JsonOpt = Annotated[Path | None, typer.Option("--json", parser=_json_path, metav
                                               help="Write a JSON report to this .json file ('-': standard output).")]
 QuietOpt = Annotated[bool, typer.Option("--quiet", "-q", help="Print only the result.")]
 StrictOpt = Annotated[bool, typer.Option("--strict", help="Treat warnings as errors.")]
-RobotOpt = Annotated[str | None, typer.Option("--robot", "-r", help="Robot name or YAML path (replaces the task's first robot).")]
+RobotOpt = Annotated[str | None, typer.Option("--robot", "-r", autocompletion=robot_names,
+                                              help="Robot name or YAML path (replaces the task's first robot).")]
 GuiOpt = Annotated[bool, typer.Option("--gui", help="Open the PyBullet GUI instead of running headless.")]
 RecordOpt = Annotated[Path | None, typer.Option("--record", parser=_record_path, metavar="PATH",
                                                 help="Save pictures: .gif or .mp4 (animation), .png (last frame), "

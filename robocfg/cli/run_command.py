@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, SeedOpt, _output_path
+from robocfg.cli.completion import task_names
 from robocfg.cli.set_option import SetOpt
 
 if TYPE_CHECKING:
@@ -44,7 +45,8 @@ def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Param
         return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation, default=default)
 
     return [
-        opt("task", Annotated[str, typer.Argument(help=f"Task name or YAML path (a 'task: {kind}' file).")], kind),
+        opt("task", Annotated[str, typer.Argument(help=f"Task name or YAML path (a 'task: {kind}' file).",
+                                                  autocompletion=task_names(kind))], kind),
         opt("robot", RobotOpt, None),
         opt("arm", Annotated[str | None, typer.Option("--arm", help="Arm to use on a multi-arm robot (default: the first).")], None),
         opt("seed", SeedOpt, None),
