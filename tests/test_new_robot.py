@@ -80,7 +80,7 @@ def test_composed_robot_draft_reproduces_the_shipped_tcp(tmp_path, capsys, monke
     assert code == 0, out
     assert "gripper parallel ['finger_joint']" in out
     draft = load_robot(tmp_path / "ur5e_2f85.yaml")
-    shipped = load_robot(ROOT / "robots" / "ur5e_robotiq_2f85.yaml")
+    shipped = load_robot(ROOT / "robocfg" / "data" / "robots" / "ur5e_robotiq_2f85.yaml")
     assert draft.config.attachments[0].urdf == "airo_models://robotiq_2f_85" and draft.config.urdf == "airo_models://ur5e"
     got, want = draft.config.arms[0], shipped.config.arms[0]
 

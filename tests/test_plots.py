@@ -40,7 +40,7 @@ def obstacle_run(tmp_path_factory):
     """A 2.5 s follow-target run with a ball next to the target (the plot is written too)."""
     tmp = tmp_path_factory.mktemp("ft")
     doc = {"schema_version": 1, "task": "follow_target",
-           "robots": [{"robot_config_file": str(ROOT / "robots" / "panda.yaml")}],
+           "robots": [{"robot_config_file": str(ROOT / "robocfg" / "data" / "robots" / "panda.yaml")}],
            "scene": {"ground": True}, "sim": {"timestep": 1 / 240},
            "follow_target": {"motion": {"type": "static", "center": [0.5, 0.3, 0.3]}, "duration": 2.5,
                              "settle_time": 1.0, "with_obstacle": True,

@@ -41,7 +41,7 @@ def test_one_jaw_face_off_the_geometry_warns(tmp_path):
 
 
 def test_failed_grasp_names_tcp_offset_against_the_closed_pads(tmp_path):
-    shipped = ROOT / "robots" / "ur5e_robotiq_2f85.yaml"
+    shipped = ROOT / "robocfg" / "data" / "robots" / "ur5e_robotiq_2f85.yaml"
     text = shipped.read_text().replace("tcp_offset: 0.144\n", "tcp_offset: 0.1303\n")
     (tmp_path / "ur5e.yaml").write_text(text)
     robot = load_robot(tmp_path / "ur5e.yaml")

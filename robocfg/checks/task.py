@@ -15,7 +15,12 @@ from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
-from robocfg.config.overrides import ROBOT_OVERRIDE_SOURCE, apply_overrides, blame_overrides, parse_key
+from robocfg.config.overrides import (
+    ROBOT_OVERRIDE_SOURCE,
+    apply_overrides,
+    blame_overrides,
+    parse_key,
+)
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
 from robocfg.errors import ConfigError, NotFound, Problem
