@@ -133,6 +133,25 @@ def test_authored_ur10e_follows_the_published_dh_table():
     assert 33.0 < sum(masses) < 36.0  # UR10e 33.5 kg + 2F-140 ≈ 1 kg
 
 
+def test_tutorial_trajectory_on_the_ur10e_takes_the_minimal_time_of_its_limits():
+    """home → reach-out → home under 0.5 rad/s² (stopping at each waypoint): the elbow's 0.77 rad
+    is the longest move, a bang-bang profile of 2·√(0.77 / 0.5) = 2.48 s per leg."""
+    from robocfg.runners.trajectory import run_trajectory
+
+    res = run_trajectory(load_task(catalog.find("tasks", "trajectory_ur10e")))
+    assert res.success
+    assert res.duration == pytest.approx(2 * 2 * math.sqrt(0.77 / 0.5), rel=0.01)
+    assert res.tracking is not None
+
+
+def test_tutorial_follow_target_on_the_ur10e_keeps_clear_of_the_obstacle_cube():
+    from robocfg.runners.follow_target import run_follow_target
+
+    res = run_follow_target(load_task(catalog.find("tasks", "follow_target_ur10e")))
+    assert res.reached and res.contacts == 0
+    assert res.min_clearance_mm is not None and res.min_clearance_mm > 15.0  # 20 mm margin, soft
+
+
 def test_2f140_strokes_140_mm_with_fingers_parallel():
     """Close the 2F-140 in steps: the measured pad gap runs from 140 mm to ≈ 0 and each pad keeps
     its orientation relative to the gripper body (the four-bar's mimic joints hold)."""
