@@ -88,6 +88,7 @@ def test_gizmo_moves_the_arm_by_ik(viewer):
 
 def test_page_shows_robot_and_slider_moves_a_link(viewer, browser, tmp_path):
     page = browser.new_page(viewport={"width": 1280, "height": 800})
+    page.set_default_timeout(120_000)  # software WebGL on a busy 2-core machine is slow
     try:
         page.goto(viewer.url)
         _wait(lambda: len(viewer.server.get_clients()) == 1, what="the page to connect")
@@ -126,6 +127,7 @@ def test_saving_a_broken_yaml_shows_its_errors_in_the_page(tmp_path, browser):
     watcher = threading.Thread(target=watch, args=(v, 0.05, stop.is_set), daemon=True)
     watcher.start()
     page = browser.new_page()
+    page.set_default_timeout(120_000)  # software WebGL on a busy 2-core machine is slow
     try:
         page.goto(v.url)
         _wait(lambda: len(v.server.get_clients()) == 1, what="the page to connect")
