@@ -213,3 +213,15 @@ def test_shell_completion_offers_task_and_robot_names():
     assert "gripper" not in _complete("robocfg run pick-place g")  # a task of another kind
     robots = _complete("robocfg run gripper --robot ur")
     assert "ur5e_robotiq_2f85" in robots and all(r.startswith("ur") for r in robots)
+
+
+def test_bad_option_values_are_named_by_their_option(capsys, monkeypatch):
+    cases = ((["ik", "panda", "--position", "0.5", "0", "0.3", "--quat-xyzw", "0", "0", "0", "0"],
+              "--quat-xyzw: quat_xyzw must be a unit quaternion"),
+             (["ik", "panda", "--position", "0.5", "0", "0.3", "--euler-deg", "1", "2", "3", "--quat-xyzw", "0", "0", "0", "1"],
+              "--euler-deg/--quat-xyzw: give one orientation"),
+             (["ik", "panda", "--position", "0.5", "0", "0.3", "--seed-q", "abc"], "--seed-q: expected numbers"),
+             (["bench", "ik", "--budget-clock", "sundial"], "--budget-clock: expected wall or cpu"))
+    for args, start in cases:
+        code, out, err = run_main(args, capsys, monkeypatch)
+        assert code == 2 and err.startswith(start) and "Traceback" not in out + err, (args, err)

@@ -25,6 +25,14 @@ def _parse_floats(text: str | None, what: str) -> list[float] | None:
         raise ConfigError([Problem("<command line>", None, None, what, f"expected numbers, got {text!r}")]) from None
 
 
+def _option_of(loc: tuple, message: str) -> str:
+    """The option(s) a pose problem came from: ``("euler_deg", 1)`` → ``--euler-deg``; a problem
+    of the whole pose names the fields its message mentions."""
+    fields = [str(x) for x in loc if isinstance(x, str)]
+    fields = fields[:1] or [f for f in ("position", "euler_deg", "quat_xyzw") if f in message]
+    return "/".join(f"--{f.replace('_', '-')}" for f in fields) or "--position"
+
+
 def _target(position: tuple[float, float, float], euler_deg: tuple[float, float, float] | None,
             quat_xyzw: tuple[float, float, float, float] | None):
     """4x4 target from the options, validated by the same Pose model the YAML files use."""
@@ -37,8 +45,8 @@ def _target(position: tuple[float, float, float], euler_deg: tuple[float, float,
         pose = Pose(position=list(position), euler_deg=list(euler_deg) if euler_deg else None,
                     quat_xyzw=list(quat_xyzw) if quat_xyzw else None)
     except ValidationError as exc:
-        raise ConfigError([Problem("<command line>", None, None, ".".join(str(x) for x in e["loc"]) or "pose",
-                                   e["msg"]) for e in exc.errors()]) from None
+        raise ConfigError([Problem("<command line>", None, None, _option_of(e["loc"], e["msg"]),
+                                   e["msg"].removeprefix("Value error, ")) for e in exc.errors()]) from None
     from robocfg.geometry import pose_matrix
 
     return pose_matrix(pose)
