@@ -2,7 +2,8 @@
 
 Every fenced code block is read; a line is a command when it starts with ``robocfg`` (after an
 optional ``$ `` prompt), and each ``robocfg`` command of a ``&&`` / ``;`` chain counts. A block
-preceded by the line ``<!-- docs-test: run -->`` is run, not only parsed.
+preceded by the line ``<!-- docs-test: run -->`` is run, not only parsed: its commands in order,
+in one folder, so a command may read what an earlier one wrote.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ class DocCommand:
     line: int
     args: tuple[str, ...]
     run: bool
+    block: int  # line of the opening fence
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}: robocfg {shlex.join(self.args)}"
@@ -42,12 +44,12 @@ def doc_commands() -> list[DocCommand]:
 def _commands_in(path: Path) -> list[DocCommand]:
     lines = path.read_text().splitlines()
     out: list[DocCommand] = []
-    fence, run, prev = None, False, ""
+    fence, run, prev, block = None, False, "", 0
     for number, line in enumerate(lines, 1):
         m = _FENCE.match(line)
         if fence is None:
             if m:
-                fence, run = m.group(2), prev.strip() == RUN_MARK
+                fence, run, block = m.group(2), prev.strip() == RUN_MARK, number
             elif line.strip():
                 prev = line
             continue
@@ -55,7 +57,7 @@ def _commands_in(path: Path) -> list[DocCommand]:
             fence, prev = None, ""
             continue
         for args in _robocfg_calls(line):
-            out.append(DocCommand(str(path.relative_to(ROOT)), number, args, run))
+            out.append(DocCommand(str(path.relative_to(ROOT)), number, args, run, block))
     return out
 
 

@@ -2,8 +2,8 @@
 
 Every ``robocfg`` command line in a fenced block is parsed by the real command tree: the command
 exists, its options exist and take the values shown (a renamed option or sub-command fails
-here). Blocks marked ``<!-- docs-test: run -->`` are also run, in a scratch folder, and must
-exit 0. To keep the run short, what a run command repeats is cut, nothing else: ``-n`` /
+here). Blocks marked ``<!-- docs-test: run -->`` are also run, each in its own scratch folder,
+command after command, and every command must exit 0. To keep the run short, what a run command repeats is cut, nothing else: ``-n`` /
 ``--episodes`` become 1, ``bench ik -n`` becomes 5, an animation ``--record`` (.gif/.mp4)
 becomes its one-frame ``.png``. A documented command that cannot run here (it serves a browser
 viewer, or needs the reader's own files) belongs in an unmarked block.
@@ -23,11 +23,12 @@ from robocfg.cli.app import app
 COMMANDS = doc_commands()
 _ROOT_COMMAND = typer.main.get_command(app)
 RUN = [c for c in COMMANDS if c.run]
+RUN_BLOCKS = {(c.file, c.block): [d for d in RUN if (d.file, d.block) == (c.file, c.block)] for c in RUN}
 
 
 def test_the_docs_show_commands_and_mark_some_to_run():
     assert len(COMMANDS) >= 40
-    assert {c.file for c in RUN} >= {"README.md"}
+    assert {c.file for c in RUN} >= {"README.md", "docs/coming-from-interndataengine.md"}
     shown = {c.args[:2] for c in RUN}
     for command in (("validate",), ("tasks",), ("run", "pick-place"), ("run", "gripper"), ("bench", "ik")):
         assert any(s[: len(command)] == command for s in shown), command
@@ -50,11 +51,12 @@ def test_documented_command_parses(command: DocCommand, tmp_path, monkeypatch):
     assert not args, f"{command}: left over {args}"
 
 
-@pytest.mark.parametrize("command", RUN, ids=str)
-def test_documented_command_runs(command: DocCommand, tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("block", list(RUN_BLOCKS), ids=lambda b: f"{b[0]}:{b[1]}")
+def test_documented_block_runs(block: tuple[str, int], tmp_path, capsys, monkeypatch):
     _scratch(tmp_path, monkeypatch)
-    code, out, err = run_main(_shortened(command.args), capsys, monkeypatch, tmp_path)
-    assert code == 0, f"{command} exited {code}\n{out[-2000:]}\n{err[-2000:]}"
+    for command in RUN_BLOCKS[block]:
+        code, out, err = run_main(_shortened(command.args), capsys, monkeypatch, tmp_path)
+        assert code == 0, f"{command} exited {code}\n{out[-2000:]}\n{err[-2000:]}"
 
 
 def _scratch(folder: Path, monkeypatch) -> None:
