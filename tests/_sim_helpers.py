@@ -7,6 +7,7 @@ from pathlib import Path
 import yaml
 
 from robocfg.checks import load_task
+from robocfg.engine.options import EpisodeObserver
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "tests" / "data"
@@ -28,3 +29,25 @@ def make_task(tmp_path: Path, robot_file: Path | str, *, objects=(), mount=None,
     path = tmp_path / name
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return load_task(path)
+
+
+class ContactSpy(EpisodeObserver):
+    """Stands in for a Recorder: after every physics step, counts steps where a moving robot link
+    or the cube penetrates the ``obstacle``."""
+
+    def __init__(self, world, obstacle: str = "wall"):
+        self.world, self.obstacle, self.checked, self.robot_hits, self.cube_hits = world, obstacle, 0, 0, 0
+
+    def maybe_capture(self):
+        import pybullet as p
+
+        w, c = self.world, self.world.client
+        wall = w.bodies[self.obstacle]
+        robot = [k for k in p.getContactPoints(w.robot.body_id, wall, physicsClientId=c) if k[8] < 0 and k[3] != -1]
+        cube = [k for k in p.getContactPoints(w.bodies["cube"], wall, physicsClientId=c) if k[8] < 0]
+        self.robot_hits += bool(robot)
+        self.cube_hits += bool(cube)
+        self.checked += 1
+
+    def save(self):
+        pass

@@ -4,11 +4,11 @@ that a joint-space transport runs into, and the robot never touches it."""
 from dataclasses import replace
 
 import pytest
+from _sim_helpers import ContactSpy
 
 from robocfg.checks import load_task
 from robocfg.config import catalog
 from robocfg.config.commands import PickPlaceParams
-from robocfg.engine.options import EpisodeObserver
 from robocfg.runners.pick_place import run_pick_place
 
 
@@ -17,33 +17,11 @@ def task():
     return load_task(catalog.find("tasks", "pick_place_obstacle"))
 
 
-class _ContactSpy(EpisodeObserver):
-    """Stands in for a Recorder: after every physics step, counts steps where a moving robot link
-    or the cube penetrates the wall."""
-
-    def __init__(self, world):
-        self.world, self.checked, self.robot_hits, self.cube_hits = world, 0, 0, 0
-
-    def maybe_capture(self):
-        import pybullet as p
-
-        w, c = self.world, self.world.client
-        wall = w.bodies["wall"]
-        robot = [k for k in p.getContactPoints(w.robot.body_id, wall, physicsClientId=c) if k[8] < 0 and k[3] != -1]
-        cube = [k for k in p.getContactPoints(w.bodies["cube"], wall, physicsClientId=c) if k[8] < 0]
-        self.robot_hits += bool(robot)
-        self.cube_hits += bool(cube)
-        self.checked += 1
-
-    def save(self):
-        pass
-
-
 def _run(task, seed: int):
     spies = []
 
     def factory(world):
-        spies.append(_ContactSpy(world))
+        spies.append(ContactSpy(world))
         return spies[-1]
 
     report, _ = run_pick_place(task, episodes=1, seed=seed, record=factory)

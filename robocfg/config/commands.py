@@ -188,7 +188,7 @@ class PickPlaceParams(Frozen):
     position_tolerance: PositiveFloat = Field(0.005, description="Phase convergence: TCP position error (m).")
     orientation_tolerance: PositiveFloat = Field(0.05, description="Phase convergence: TCP orientation error (rad).")
     timeouts: PhaseTimeouts = Field(default_factory=PhaseTimeouts)
-    motion: Literal["trajectory", "reactive"] = Field("trajectory", description="How the arm makes the free-space moves (pre-grasp, transport): 'trajectory' = IK + min-jerk timed joint trajectories; 'reactive' = the follow-target controller, which keeps the arm 2 cm clear of the scene (ground, table, pedestal, obstacles). The short straight moves near the object always use IK + min-jerk.")
+    motion: Literal["trajectory", "reactive", "planned"] = Field("trajectory", description="How the arm makes the free-space moves (pre-grasp, transport): 'trajectory' = IK + min-jerk timed joint trajectories; 'reactive' = the follow-target controller, which keeps the arm 2 cm clear of the scene (ground, table, pedestal, obstacles); 'planned' = a collision-free joint path (OMPL RRT-Connect, arm and held object 1 cm clear of the scene), shortened and toppra-timed. The short straight moves near the object always use IK + min-jerk.")
     speed_scale: Annotated[float, Field(gt=0, le=1)] = Field(0.5, description="Fraction of joint velocity limits used.")
     grip_force: PositiveFloat | None = Field(None, description="Overrides the gripper's max_force.")
     success_tolerance: PositiveFloat = Field(0.02, description="Horizontal place error allowed (m).")

@@ -20,7 +20,7 @@ from robocfg.engine.options import FrameRecorder, RunOptions, option
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
-from robocfg.runners.pick_place_machine import EpisodeSetup, _StateMachine, _Tools, reactive_drive
+from robocfg.runners.pick_place_machine import EpisodeSetup, _StateMachine, _Tools, planned_drive, reactive_drive
 from robocfg.runners.pick_place_report import EpisodeResult, PickPlaceReport, summarise
 
 __all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episode_setup", "episode_setups",
@@ -87,7 +87,8 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         scale = self.params.speed_scale
         self.tools = _Tools(model, limits_from_robot(robot, self.handle.joints,
                                                      Limits(velocity_scale=scale, acceleration_scale=scale)),
-                            reactive_drive(robot, self.world, self.arm_cfg.name, self.params))
+                            reactive_drive(robot, self.world, self.arm_cfg.name, self.params),
+                            planned_drive(robot, self.world, model, self.params))
 
     def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
         setup = episode_setup(self.params, self.seed, k)
@@ -113,6 +114,8 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         skipped = self.tools.reactive.skipped if self.tools.reactive is not None else []
         warnings = [w.format() for w in self.task.warnings]
         warnings += [f"obstacle {name!r} is a mesh: the reactive controller does not avoid it" for name in skipped]
+        unseen = self.tools.planned.skipped if self.tools.planned is not None else []
+        warnings += [f"obstacle {name!r} is a mesh: the planner does not avoid it" for name in unseen]
         return PickPlaceReport(task=str(self.task.path), robot=self.task.robots[0].config.name,
                                arm=self.arm_cfg.name, seed=self.seed, summary=summarise(records), episodes=records,
                                warnings=warnings, interrupted=interrupted)

@@ -49,11 +49,13 @@ class EpisodeSetup:
 @dataclass(frozen=True)
 class _Tools:
     """Per-run helpers shared by every episode: kinematic model, scaled joint limits and, with
-    ``motion: reactive``, the follow-target controller driving the free-space moves."""
+    ``motion: reactive``, the follow-target controller driving the free-space moves (with ``motion:
+    planned``, the global planner)."""
 
     model: Any
     limits: Any
     reactive: Any = None
+    planned: Any = None  # motion: planned — a robocfg.planning.drive.PlannedDrive
 
 
 def reactive_drive(robot, world: World, arm_name: str, params: PickPlaceParams):
@@ -68,6 +70,15 @@ def reactive_drive(robot, world: World, arm_name: str, params: PickPlaceParams):
                                 payload=(beyond, bounding_radius(obj)))
 
 
+def planned_drive(robot, world: World, model, params: PickPlaceParams):
+    """The global planner for ``motion: planned`` (built once per run), else None."""
+    if params.motion != "planned":
+        return None
+    from robocfg.planning.drive import build_planned_drive
+
+    return build_planned_drive(robot, world, model)
+
+
 class _StateMachine:
     def __init__(self, world, arm, tools: _Tools, params: PickPlaceParams, setup: EpisodeSetup, recorder,
                  log: Log | None):
@@ -76,6 +87,9 @@ class _StateMachine:
         self.arm, self.cfg, self.gripper = arm, arm.config, arm.require_gripper()
         self.model = tools.model
         self.reactive = tools.reactive
+        self.planned = tools.planned
+        if self.planned is not None:  # a failed episode may have left its object attached
+            self.planned.detach(setup.body.name)
         self.mover = ArmMover(world, arm, tools.model, tools.limits, params.position_tolerance,
                               params.orientation_tolerance, on_step=self._on_step, phase="setup")
         if params.grip_force is not None:
@@ -122,12 +136,16 @@ class _StateMachine:
         T_place[:3, 3] = place_obj + offset
         T_above_place = T_place.copy()
         T_above_place[2, 3] = max(T_lift[2, 3], T_place[2, 3] + p.lift_height)
+        if self.planned is not None:
+            self._attach_held()
         self.begin("transport", "carry above the place point")
         self._free_move(T_above_place, check=self._dropped)
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
         self.begin("release", "open the gripper")
         self._release()
+        if self.planned is not None:
+            self.planned.detach(self.setup.body.name)
         self.begin("retract", "move up and away")
         self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
         self.close_phase(True)
@@ -154,10 +172,21 @@ class _StateMachine:
     # ---- motion ------------------------------------------------------------------------------
     def _free_move(self, T: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
         """A free-space move (pre-grasp, transport): joint-space trajectory or reactive controller."""
-        if self.reactive is None:
+        if self.planned is not None:
+            self.planned.move(self.mover, T, check=check)
+        elif self.reactive is None:
             self.mover.move(T, straight=False, check=check)
         else:
             self.mover.move_reactive(T, self.reactive, check=check)
+
+    def _attach_held(self) -> None:
+        """Give the planner the held object, where it now sits in the hand."""
+        from robocfg.geometry import quat_to_matrix
+
+        pos, quat = self.world.body_pose(self.obj)
+        T_obj = np.eye(4)
+        T_obj[:3, :3], T_obj[:3, 3] = quat_to_matrix(quat), pos
+        self.planned.attach(self.setup.body.name, self.setup.body, np.linalg.inv(self.arm.ee_pose()) @ T_obj)
 
     def _choose_grasp(self, center: np.ndarray) -> Grasp:
         """Of the two top-down grasps, the one needing the least joint travel (largest |Δq|, rad)

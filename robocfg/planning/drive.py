@@ -1,0 +1,117 @@
+"""Planned free-space moves for :class:`~robocfg.motion.moves.ArmMover` (pick-place ``motion: planned``).
+
+A move to an EE pose: IK for the goal (seeded from the current joints; if that answer collides,
+a few seeded restarts for a collision-free one), a collision-free joint path from the
+:class:`JointPlanner`, toppra timing, then the same trajectory playback and convergence check as
+every other move. A held object is attached to the hand's collision model while it is carried
+(:meth:`PlannedDrive.attach`), so neither it nor the arm is planned through the scene.
+
+Build the drive once per run (:func:`build_planned_drive`): it convex-hulls every collision mesh.
+Frames: world, 4×4, metres; joints in arm order, rad.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robocfg.collision import EnvShape
+from robocfg.errors import PhaseFailed
+from robocfg.planning.checker import CollisionChecker
+from robocfg.planning.planner import JointPlanner, PlannedPath, PlannerSettings, PlanningFailed
+
+if TYPE_CHECKING:
+    from robocfg.checks.robot import CheckedRobot
+    from robocfg.config.scene import Body
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.moves import ArmMover
+    from robocfg.sim.world import World
+
+GOAL_IK_RESTARTS = 8  # extra IK seeds tried when the nearest IK answer for a goal collides
+
+
+@dataclass
+class PlannedDrive:
+    """A planner for one arm in a task's scene, and what it planned (``paths``, in order)."""
+
+    planner: JointPlanner
+    kin: KinematicModel
+    ee_link: str
+    skipped: list[str]  # scene bodies the planner cannot see (meshes)
+    paths: list[PlannedPath] = field(default_factory=list)
+
+    @property
+    def checker(self) -> CollisionChecker:
+        return self.planner.checker
+
+    def attach(self, name: str, body: Body, T_ee_body: np.ndarray) -> None:
+        """Carry ``body`` at ``T_ee_body`` (4×4, its centre in the EE link frame, m)."""
+        from robocfg.motion.reactive_drive import bounding_radius
+
+        if body.shape == "mesh":  # its extent is not known here: a bounding sphere of the scale box
+            shape = EnvShape(name, "sphere", (bounding_radius(body),), np.asarray(T_ee_body, float))
+        else:
+            shape = EnvShape(name, body.shape, tuple(body.size), np.asarray(T_ee_body, float))
+        self.checker.attach(name, shape, self.ee_link)
+
+    def detach(self, name: str) -> None:
+        self.checker.detach(name)
+
+    def goal(self, mover: ArmMover, T_goal: np.ndarray, q0: np.ndarray) -> np.ndarray:
+        """A collision-free IK answer for ``T_goal`` (EE, world): the one nearest ``q0`` if it is
+        free, else the free answer with the least joint travel among seeded restarts."""
+        q = mover.solve(T_goal, q0)
+        if self.checker.is_valid(q):
+            return q
+        rng = np.random.default_rng([len(q0), 0x1C])
+        best, travel = None, np.inf
+        for _ in range(GOAL_IK_RESTARTS):
+            seed = rng.uniform(self.kin.lower, self.kin.upper)
+            res = self.kin.ik(T_goal, seed_q=seed, frame="ee", time_budget=mover.ik_budget, rng=rng)
+            if res.converged and self.checker.is_valid(res.q):
+                d = float(np.max(np.abs(res.q - q0)))
+                if d < travel:
+                    best, travel = res.q, d
+        if best is None:  # every answer collides: name what the nearest one hits
+            hits = ", ".join(c.describe() for c in self.checker.contacts(q)[:3])
+            raise PhaseFailed(mover.phase, f"the goal configuration is in collision ({hits}, "
+                                           f"margin {self.checker.margin * 1000:.0f} mm)")
+        return best
+
+    def move(self, mover: ArmMover, T_goal: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
+        """Move ``mover``'s arm to ``T_goal`` (EE, world) along a planned collision-free path."""
+        q0 = mover.arm.joint_positions()
+        q_goal = self.goal(mover, T_goal, q0)
+        try:
+            path = self.planner.plan(q0, q_goal)
+        except PlanningFailed as exc:
+            raise PhaseFailed(mover.phase, exc.reason) from None
+        self.paths.append(path)
+        plan = self.planner.timed(path, mover.limits)
+        if plan.duration > mover.timeout:
+            raise PhaseFailed(mover.phase, f"motion needs {plan.duration:.2f} s, more than the {mover.timeout:.2f} s timeout")
+        t_start = mover.world.t
+        if plan.duration > 0:
+            mover.play(plan.trajectory)
+        mover.converge(T_goal, t_start)
+        if check is not None:
+            reason = check()
+            if reason:
+                raise PhaseFailed(mover.phase, reason)
+
+
+def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
+                        settings: PlannerSettings = PlannerSettings(), margin: float | None = None) -> PlannedDrive:
+    """Planner for the arm of ``kin`` (a KinematicModel of ``robot``) among ``world``'s task scene
+    (ground, table, pedestal, obstacles; movable objects are not avoided)."""
+    from robocfg.collision import robot_geometry
+    from robocfg.motion.reactive.setup import scene_shapes
+    from robocfg.planning.checker import DEFAULT_MARGIN
+
+    links, _ = robot_geometry(robot)
+    env, skipped = scene_shapes(world.task.config.scene)
+    checker = CollisionChecker(kin, links, env, DEFAULT_MARGIN if margin is None else margin)
+    return PlannedDrive(JointPlanner(checker, kin.lower, kin.upper, settings), kin, kin.ee_link, skipped)

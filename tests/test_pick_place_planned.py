@@ -1,0 +1,61 @@
+"""Pick-place with ``motion: planned``: the global planner carries the cube round the wall of the
+obstacle task (held cube attached to the hand's collision model), and nothing touches the wall."""
+
+from dataclasses import replace
+
+import pytest
+from _sim_helpers import ContactSpy
+
+from robocfg.checks import load_task
+from robocfg.config import catalog
+from robocfg.runners.pick_place import run_pick_place
+
+
+@pytest.fixture(scope="module")
+def task():
+    reactive = load_task(catalog.find("tasks", "pick_place_obstacle"))
+    params = reactive.config.pick_place.model_copy(update={"motion": "planned"})
+    return replace(reactive, config=reactive.config.model_copy(update={"pick_place": params}))
+
+
+def _run(task, seed: int, episodes: int = 1):
+    spies = []
+
+    def factory(world):
+        spies.append(ContactSpy(world))
+        return spies[-1]
+
+    report, _ = run_pick_place(task, episodes=episodes, seed=seed, record=factory)
+    return report, spies[0]
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_planned_transport_goes_round_the_wall(task, seed):
+    report, spy = _run(task, seed)
+    episode = report.episodes[0]
+    assert episode.success, (episode.failed_phase, episode.reason)
+    assert [p.name for p in episode.phases][:5] == ["pre_grasp", "approach", "grasp", "lift", "transport"]
+    assert spy.checked > 500
+    assert spy.robot_hits == 0
+    assert spy.cube_hits == 0
+
+
+def test_same_seed_same_report(task):
+    a, _ = _run(task, 5, episodes=2)
+    b, _ = _run(task, 5, episodes=2)
+    assert a == b
+
+
+def test_place_behind_a_wall_fails_transport_naming_the_wall(task):
+    """A wall too tall and long to pass, between the pick and the place point: every arm pose
+    above the place point crosses it, so the transport phase fails before moving, naming the wall."""
+    scene = task.config.scene
+    wall = scene.obstacles[0].model_copy(update={"size": [4.0, 0.04, 1.6], "position": [0.0, 0.17, 0.8]})
+    blocked = replace(task, config=task.config.model_copy(update={"scene": scene.model_copy(update={"obstacles": [wall]})}))
+    report, spy = _run(blocked, 0)
+    episode = report.episodes[0]
+    assert not episode.success
+    assert episode.failed_phase == "transport", episode.reason
+    assert episode.reason.startswith("the goal configuration is in collision (panda_link")
+    assert "with wall" in episode.reason
+    assert spy.robot_hits == 0 and spy.cube_hits == 0
