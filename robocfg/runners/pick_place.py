@@ -20,7 +20,13 @@ from robocfg.engine.options import FrameRecorder, RunOptions, option
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
-from robocfg.runners.pick_place_machine import EpisodeSetup, _StateMachine, _Tools, planned_drive, reactive_drive
+from robocfg.runners.pick_place_machine import (
+    EpisodeSetup,
+    _StateMachine,
+    _Tools,
+    planned_drive,
+    reactive_drive,
+)
 from robocfg.runners.pick_place_report import EpisodeResult, PickPlaceReport, summarise
 
 __all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episode_setup", "episode_setups",
