@@ -13,9 +13,13 @@ from robocfg.runners.pick_place import run_pick_place
 
 @pytest.fixture(scope="module")
 def task():
+    return load_task(catalog.find("tasks", "pick_place_obstacle_planned"))
+
+
+def test_the_planned_task_is_the_obstacle_scene(task):
     reactive = load_task(catalog.find("tasks", "pick_place_obstacle"))
-    params = reactive.config.pick_place.model_copy(update={"motion": "planned"})
-    return replace(reactive, config=reactive.config.model_copy(update={"pick_place": params}))
+    assert task.config.pick_place.motion == "planned"
+    assert task.config.scene == reactive.config.scene
 
 
 def _run(task, seed: int, episodes: int = 1):

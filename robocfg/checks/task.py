@@ -12,6 +12,7 @@ import numpy as np
 from pydantic import TypeAdapter
 
 from robocfg.checks.robot import CheckedRobot, load_robot
+from robocfg.checks.scene import check_scene
 from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
@@ -176,6 +177,8 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
                 problems.append(doc.problem(loc, what))
             problems.extend(exc.problems)
     warnings: list[Problem] = []
+    obj = config.pick_place.object if isinstance(config, PickPlaceTask) else None
+    problems += check_scene(doc, config.scene, [] if obj is None else [(("pick_place", "object"), obj)])
     if not problems:
         problems += check_task_params(doc, config, robots[0])
     if not problems and isinstance(config, PickPlaceTask):

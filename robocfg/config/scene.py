@@ -6,6 +6,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
+from robocfg.config.fixtures import Fixture
 from robocfg.config.types import Frozen, NonNegFloat, Pose, PositiveFloat, Vec3, Vec4
 
 Color = Vec4
@@ -65,6 +66,11 @@ class Scene(Frozen):
     pedestal: Pedestal | None = Field(None, description="Optional static pedestal (place the robot on its top face).")
     objects: list[Body] = Field(default_factory=list, description="Movable objects (names unique among objects and obstacles).")
     obstacles: list[Body] = Field(default_factory=list, description="Static obstacles (mass is ignored).")
+    fixtures: list[Fixture] = Field(default_factory=list, description="Static fixtures built from boxes: bins (type: bin), shelves with levels (type: shelf), blocks (type: block); parts are named FIXTURE/PART.")
+
+    def fixture_parts(self) -> list[Body]:
+        """Every fixture's boxes (static bodies, world poses)."""
+        return [part for f in self.fixtures for part in f.parts()]
 
 
 class Sim(Frozen):

@@ -115,7 +115,7 @@ class World(SceneQueries):
             self.bodies["pedestal"] = spawn_pedestal(c, scene.pedestal)
         for mount, checked in zip(cfg.robots, self.task.robots, strict=True):
             self.robots.append(self._load_robot(checked, mount))
-        for ob in scene.obstacles:
+        for ob in [*scene.obstacles, *scene.fixture_parts()]:
             self._register(ob.name, spawn_body(c, ob, base_dir, static=True), dynamic=False)
         for ob in scene.objects:
             self._register(ob.name, spawn_body(c, ob, base_dir), dynamic=ob.mass > 0)

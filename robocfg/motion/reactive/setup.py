@@ -65,7 +65,8 @@ def body_shape(body: Body | FollowObstacle, obstacle: bool = True) -> EnvShape |
 
 
 def scene_shapes(scene: Scene) -> tuple[list[EnvShape], list[str]]:
-    """(environment shapes, names of bodies left out) for the ground, table, pedestal and obstacles.
+    """(environment shapes, names of bodies left out) for the ground, table, pedestal, obstacles and
+    fixture parts.
     Movable ``objects`` are not avoided (the robot may touch them)."""
     shapes: list[EnvShape] = []
     skipped: list[str] = []
@@ -79,7 +80,7 @@ def scene_shapes(scene: Scene) -> tuple[list[EnvShape], list[str]]:
         T = pose_matrix(scene.pedestal)
         T[:3, 3] -= T[:3, 2] * scene.pedestal.height / 2
         shapes.append(EnvShape("pedestal", "cylinder", (scene.pedestal.radius, scene.pedestal.height), T, obstacle=False))
-    for ob in scene.obstacles:
+    for ob in [*scene.obstacles, *scene.fixture_parts()]:
         s = body_shape(ob)
         if s is None:
             skipped.append(ob.name)
