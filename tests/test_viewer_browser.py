@@ -146,3 +146,34 @@ def test_saving_a_broken_yaml_shows_its_errors_in_the_page(tmp_path, browser):
         watcher.join(5)
         page.close()
         v.stop()
+
+
+def test_task_cameras_are_frusta_and_the_wrist_one_follows_the_arm():
+    v = BrowserViewer(find_source("pick_place"), port=_free_port())
+    try:
+        names = v.scene_names()
+        assert {"/cameras/scene", "/cameras/wrist"} <= set(names)
+        by_name = {c.camera.name: c for c in v.cameras}
+        scene, wrist = by_name["scene"], by_name["wrist"]
+        cam = scene.camera
+        # the scene camera sits at its position, optical axis (z) towards look_at, image y down
+        R = np.asarray(_quat_matrix(scene.handle.wxyz))
+        assert np.allclose(scene.handle.position, cam.position)
+        axis = np.subtract(cam.look_at, cam.position)
+        assert np.allclose(R[:, 2], axis / np.linalg.norm(axis), atol=1e-6)
+        assert R[:, 1] @ np.asarray(cam.up) < 0
+        fixed, moving = np.array(scene.handle.position), np.array(wrist.handle.position)
+        ee = v.robots[0].link_pose(v.robots[0].checked.config.arms[0].ee_link)
+        assert np.allclose(moving, ee[:3, :3] @ np.asarray(wrist.camera.position) + ee[:3, 3], atol=1e-6)
+        v.set_joint("panda_joint1", 0.8)
+        assert np.linalg.norm(np.array(wrist.handle.position) - moving) > 0.05  # the wrist camera went along
+        assert np.allclose(scene.handle.position, fixed)  # the scene camera did not
+    finally:
+        v.stop()
+
+
+def _quat_matrix(wxyz) -> np.ndarray:
+    from robocfg.geometry import quat_to_matrix
+
+    w, x, y, z = wxyz
+    return quat_to_matrix([x, y, z, w])

@@ -23,7 +23,10 @@ def view(
     """Show a robot, or a task's scene, with its frames. Base, ee_link, TCP and grasp frames,
     ee_axis and finger pads; in the browser, or as a PNG sheet with --png."""
     from robocfg.cli.ik import _parse_floats
+    from robocfg.sim.quiet import quiet_import
     from robocfg.viewer.source import find_source
+
+    quiet_import()  # the picture and the URDF preparation load pybullet: no build banner
 
     source = find_source(target, overrides(set_))
     joints = _parse_floats(q, "--q")

@@ -6,7 +6,8 @@ viser (not meshcat) because it serves its client from the wheel (no download, wo
 machine through an SSH tunnel), has GUI widgets (sliders, checkboxes, markdown) and a transform
 gizmo, and draws URDFs from yourdfpy, which robocfg already uses. Meshes come from the same URDF
 PyBullet loads (``package://`` resolved, attachments composed). Poses: world frame, metres; a task
-YAML's robots stand at their mounts, with its table, pedestal, objects, obstacles and place target.
+YAML's robots stand at their mounts, with its table, pedestal, objects, obstacles, place target and
+the frusta of its dataset cameras (a wrist camera moves with the arm).
 
 ``reload()`` rebuilds the page from the YAML; when the YAML is invalid the page shows its
 ``FILE:LINE:COL: field: message`` lines instead (``errors`` holds them).
@@ -14,6 +15,8 @@ YAML's robots stand at their mounts, with its table, pedestal, objects, obstacle
 
 from __future__ import annotations
 
+import contextlib
+import io
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -26,6 +29,7 @@ from robocfg.errors import ConfigError
 from robocfg.geometry.pose import pose_matrix, pose_to_matrix
 from robocfg.geometry.rotation import matrix_to_quat
 from robocfg.viewer.frames import BOX_EDGES, ArmFrames, arm_frames, pad_boxes_ee
+from robocfg.viewer.frusta import ShownCamera, add_frusta
 from robocfg.viewer.scenery import add_scenery
 from robocfg.viewer.source import ViewSource
 
@@ -66,17 +70,23 @@ class BrowserViewer:
         import viser
 
         self.source, self.q0 = source, None if q is None else list(q)
-        self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner whatever ``verbose`` says
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.lock = threading.RLock()
         self.robots: list[ShownRobot] = []
         self.frames: list[ArmFrames] = []
         self.sliders: dict[str, object] = {}
+        self.cameras: list[ShownCamera] = []
         self.errors: list[str] = []
         self.watched: list = [source.path]
         self.ik_status = ""
         self._model = None
         self._syncing = False
-        self.reload()
+        try:
+            self.reload()
+        except BaseException:  # Ctrl-C while loading: stop the server quietly
+            self.stop()
+            raise
 
     @property
     def url(self) -> str:
@@ -89,6 +99,7 @@ class BrowserViewer:
             self.server.scene.reset()
             self.server.gui.reset()
             self.robots, self.frames, self.sliders, self._model = [], [], {}, None
+            self.cameras = []
             try:
                 checked = self.source.load()
             except ConfigError as exc:
@@ -104,6 +115,8 @@ class BrowserViewer:
                 add_scenery(self.server, checked)
             for k, (robot, mount) in enumerate(zip(robots, mounts, strict=True)):
                 self.robots.append(self._add_robot(robot, mount, f"/robot{k}"))
+            if self.source.kind == "task":
+                self.cameras = add_frusta(self.server, list(checked.config.cameras), self._ee_pose(), wxyz)
             self._add_gui()
             self.refresh()
             self._fit_camera()
@@ -218,6 +231,10 @@ class BrowserViewer:
                     f = arm_frames(arm, r.link_pose, pad_boxes_ee(r.checked, arm), length)
                     self.frames.append(f)
                     self._draw(f, f"{r.node}_frames/{arm.name}")
+            T_ee = self._ee_pose()
+            for cam in self.cameras:
+                if cam.camera.mount == "ee":
+                    cam.place(T_ee, wxyz)
             self._syncing = True
             try:
                 for name, s in self.sliders.items():
@@ -226,6 +243,13 @@ class BrowserViewer:
                         s.value = v  # type: ignore[attr-defined]
             finally:
                 self._syncing = False
+
+    def _ee_pose(self) -> np.ndarray | None:
+        """World pose of the first arm's ``ee_link`` (where ``mount: ee`` cameras sit)."""
+        if not self.robots:
+            return None
+        first = self.robots[0]
+        return first.link_pose(first.checked.config.arms[0].ee_link)
 
     def _draw(self, f: ArmFrames, node: str) -> None:
         scene = self.server.scene
@@ -245,4 +269,5 @@ class BrowserViewer:
         return sorted(self.server.scene._handle_from_node_name)  # viser keeps no public listing
 
     def stop(self) -> None:
-        self.server.stop()
+        with contextlib.redirect_stdout(io.StringIO()):  # and "(viser) Server stopped"
+            self.server.stop()
