@@ -177,3 +177,47 @@ def _quat_matrix(wxyz) -> np.ndarray:
 
     w, x, y, z = wxyz
     return quat_to_matrix([x, y, z, w])
+
+
+@pytest.fixture(scope="module")
+def pick_place_playback():
+    from robocfg.checks import load_task
+    from robocfg.viewer.playback import record_run
+
+    return record_run(load_task(catalog.find("tasks", "pick_place")), seed=0)
+
+
+def test_a_recorded_pick_place_plays_back_in_the_page(pick_place_playback):
+    pb = pick_place_playback
+    assert pb.success is True and pb.duration > 3.0
+    names = [name for name, _ in pb.phases()]
+    assert {"grasp", "lift", "place"} & set(names) and names.index("lift") > names.index("grasp")
+    v = BrowserViewer(find_source("pick_place"), port=_free_port(), playback=pb)
+    try:
+        obj = v.source.load().config.pick_place.object.name
+        handle = v.scenery[obj]
+        v.show_time(0.0)
+        z0, q0 = handle.position[2], dict(v.robots[0].q)
+        lift = dict(pb.phases())["lift"]
+        t_lifted = next(f.t for f in pb.frames if f.t > lift and f.bodies[obj][0][2] > z0 + 0.03)
+        v.time_slider.value = t_lifted  # as the page's slider does
+        _wait(lambda: handle.position[2] > z0 + 0.03, timeout=10, what="the object to rise with the slider")
+        assert np.allclose(handle.position, pb.at(t_lifted).bodies[obj][0])
+        assert any(abs(v.robots[0].q[j] - q0[j]) > 0.05 for j in q0)  # the arm moved too
+        assert v._phase_text.content.endswith(f"phase: {pb.at(t_lifted).phase}")
+        assert pb.at(t_lifted).phase not in ("", "pre_grasp", "approach", "grasp")  # it is past the grasp
+        v.toggle_play()  # plays from there to the end in real time, then stops
+        _wait(lambda: not v._playing.is_set(), timeout=30, what="the playback to end")
+        assert v.time_slider.value == pytest.approx(pb.duration)
+        final = pb.frames[-1].bodies[obj][0]
+        assert np.allclose(handle.position, final)
+    finally:
+        v.stop()
+
+
+@pytest.mark.parametrize(("target", "says"), [("panda", "is a robot YAML"), ("pick_place", "is a 'pick_place' task, not 'grasp'")])
+def test_run_option_names_what_cannot_be_played(target, says, capsys, monkeypatch):
+    from _cli import run_main
+
+    code, _, err = run_main(["view", target, "--run", "grasp"], capsys, monkeypatch)
+    assert code == 2 and says in " ".join(err.split()) and "Traceback" not in err

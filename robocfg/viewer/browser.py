@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import io
 import threading
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import partial
@@ -30,6 +31,7 @@ from robocfg.geometry.pose import pose_matrix, pose_to_matrix
 from robocfg.geometry.rotation import matrix_to_quat
 from robocfg.viewer.frames import BOX_EDGES, ArmFrames, arm_frames, pad_boxes_ee
 from robocfg.viewer.frusta import ShownCamera, add_frusta
+from robocfg.viewer.playback import Playback
 from robocfg.viewer.scenery import add_scenery
 from robocfg.viewer.source import ViewSource
 
@@ -66,10 +68,14 @@ class BrowserViewer:
     """A viser server showing ``source``; see the module docstring."""
 
     def __init__(self, source: ViewSource, host: str = "127.0.0.1", port: int = 8080,
-                 q: Sequence[float] | None = None):
+                 q: Sequence[float] | None = None, playback: Playback | None = None):
         import viser
 
         self.source, self.q0 = source, None if q is None else list(q)
+        self.playback = playback
+        self.scenery: dict[str, object] = {}
+        self._playing = threading.Event()
+        self._player: threading.Thread | None = None
         with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner whatever ``verbose`` says
             self.server = viser.ViserServer(host=host, port=port, verbose=False)
         self.lock = threading.RLock()
@@ -112,12 +118,14 @@ class BrowserViewer:
             self.watched = [self.source.path, *(r.path for r in robots)]
             mounts = [np.eye(4)] if self.source.kind == "robot" else [pose_matrix(m) for m in checked.config.robots]
             if self.source.kind == "task":
-                add_scenery(self.server, checked)
+                self.scenery = add_scenery(self.server, checked)
             for k, (robot, mount) in enumerate(zip(robots, mounts, strict=True)):
                 self.robots.append(self._add_robot(robot, mount, f"/robot{k}"))
             if self.source.kind == "task":
                 self.cameras = add_frusta(self.server, list(checked.config.cameras), self._ee_pose(), wxyz)
             self._add_gui()
+            if self.playback is not None:
+                self._add_playback_gui(self.playback)
             self.refresh()
             self._fit_camera()
 
@@ -186,6 +194,57 @@ class BrowserViewer:
         self.target = self.server.scene.add_transform_controls("/target", scale=size, position=tuple(T_tcp[:3, 3]),
                                                                wxyz=wxyz(T_tcp[:3, :3]))
         self.target.on_update(lambda _event: self.follow_target())
+
+    def _add_playback_gui(self, pb: Playback) -> None:
+        gui = self.server.gui
+        outcome = "" if pb.success is None else ("succeeded" if pb.success else f"failed ({pb.reason})")
+        phases = ", ".join(f"{name or 'start'} {t:.2f} s" for name, t in pb.phases())
+        with gui.add_folder("playback"):
+            gui.add_markdown(f"recorded run, {pb.duration:.2f} s simulated, {outcome}  \nphases: {phases}")
+            self.time_slider = gui.add_slider("t (s)", min=0.0, max=max(pb.duration, 1e-3),
+                                              step=max(pb.duration, 1e-3) / 500, initial_value=0.0)
+            self.time_slider.on_update(lambda _event: self.show_time(float(self.time_slider.value)))
+            self._phase_text = gui.add_markdown("")
+            play = gui.add_button("play / pause")
+            play.on_click(lambda _event: self.toggle_play())
+        self.show_time(0.0)
+
+    def show_time(self, t: float) -> None:
+        """Pose the robots and the free bodies as the playback has them at time ``t`` (s)."""
+        if self.playback is None:
+            return
+        with self.lock:
+            frame = self.playback.at(t)
+            for robot, q in zip(self.robots, frame.joints, strict=False):
+                robot.q.update(q)
+            for name, (pos, quat) in frame.bodies.items():
+                handle = self.scenery.get(name)
+                if handle is not None:
+                    x, y, z, w = quat
+                    handle.position, handle.wxyz = pos, (w, x, y, z)  # type: ignore[attr-defined]
+            self._phase_text.content = f"t = {frame.t:.2f} s, phase: {frame.phase or 'start'}"
+            self.refresh()
+
+    def toggle_play(self) -> None:
+        """Start playing from the slider's time in real time (from the start once at the end), or pause."""
+        if self._playing.is_set():
+            self._playing.clear()
+            return
+        self._playing.set()
+        self._player = threading.Thread(target=self._play, daemon=True)
+        self._player.start()
+
+    def _play(self, step: float = 1 / 30) -> None:
+        assert self.playback is not None
+        t = float(self.time_slider.value)
+        if t >= self.playback.duration - 1e-6:
+            t = 0.0
+        start = time.monotonic() - t
+        while self._playing.is_set() and t < self.playback.duration:
+            t = min(time.monotonic() - start, self.playback.duration)
+            self.time_slider.value = t  # its update handler poses the scene
+            time.sleep(step)
+        self._playing.clear()
 
     # ---- updates ------------------------------------------------------------------------
     def _on_slider(self, name: str, _event) -> None:
@@ -269,5 +328,6 @@ class BrowserViewer:
         return sorted(self.server.scene._handle_from_node_name)  # viser keeps no public listing
 
     def stop(self) -> None:
+        self._playing.clear()
         with contextlib.redirect_stdout(io.StringIO()):  # and "(viser) Server stopped"
             self.server.stop()

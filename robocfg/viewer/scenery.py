@@ -41,8 +41,11 @@ def _colored(mesh: trimesh.Trimesh, rgba) -> trimesh.Trimesh:
     return mesh
 
 
-def add_scenery(server, task: CheckedTask) -> list[str]:
-    """Add the task's bodies to ``server``'s scene; returns the node names."""
+def add_scenery(server, task: CheckedTask) -> dict[str, object]:
+    """Add the task's bodies to ``server``'s scene; returns the scene handles by body name (a
+    body's mesh is in its own frame and the handle carries its pose, so a playback can move it)."""
+    from robocfg.geometry.rotation import matrix_to_quat
+
     cfg, base = task.config, task.path.parent
     items: list[tuple[str, trimesh.Trimesh, np.ndarray]] = []
     scene = cfg.scene
@@ -68,10 +71,9 @@ def add_scenery(server, task: CheckedTask) -> list[str]:
         mesh = body_mesh(b, base)
         if mesh is not None:
             items.append((b.name, _colored(mesh, b.color), pose_matrix(b)))
-    names = []
+    handles = {}
     for name, mesh, T in items:
-        mesh.apply_transform(T)
-        node = f"/scene/{name}"
-        server.scene.add_mesh_trimesh(node, mesh)
-        names.append(node)
-    return names
+        x, y, z, w = matrix_to_quat(T[:3, :3])
+        handles[name] = server.scene.add_mesh_trimesh(f"/scene/{name}", mesh, position=tuple(float(v) for v in T[:3, 3]),
+                                                      wxyz=(float(w), float(x), float(y), float(z)))
+    return handles

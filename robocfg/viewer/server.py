@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from robocfg.viewer.browser import BrowserViewer
+from robocfg.viewer.playback import Playback
 from robocfg.viewer.source import ViewSource
 
 
@@ -37,9 +38,9 @@ def watch(viewer: BrowserViewer, poll_s: float = 0.5, until: Callable[[], bool] 
 
 
 def serve(source: ViewSource, host: str = "127.0.0.1", port: int = 8080, q: Sequence[float] | None = None,
-          on_ready: Callable[[str], None] = lambda url: None) -> None:
-    """Run the viewer until Ctrl-C."""
-    viewer = BrowserViewer(source, host=host, port=port, q=q)
+          on_ready: Callable[[str], None] = lambda url: None, playback: Playback | None = None) -> None:
+    """Run the viewer until Ctrl-C (with ``playback``: a recorded run to play in the page)."""
+    viewer = BrowserViewer(source, host=host, port=port, q=q, playback=playback)
     on_ready(viewer.url)
     try:
         watch(viewer)
