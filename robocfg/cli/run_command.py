@@ -2,7 +2,8 @@
 output-path checks, exit codes, SIGINT partial report and printing for every registered kind.
 
 The options every kind gets: ``TASK``, ``--robot/-r``, ``--arm``, ``--seed``, ``-n/--episodes``,
-``--json``, ``--record``, ``--record-episode``, ``--gui``, ``-q``, ``--min-success``, ``--set``. A kind's own
+``--json``, ``--record``, ``--record-episode``, ``--camera``, ``--size``, ``--fps``, ``--gui``, ``-q``,
+``--min-success``, ``--set``. A kind's own
 options are the fields of its ``Options`` dataclass (``robocfg.engine.option``). Front-end
 additions that need the CLI's own imports (the dataset sink of pick-place) are :class:`CliHook` s.
 """
@@ -20,6 +21,7 @@ import typer
 
 from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, SeedOpt, _output_path
 from robocfg.cli.completion import task_names
+from robocfg.cli.record_opts import CameraOpt, FpsOpt, SizeOpt, record_settings
 from robocfg.cli.set_option import SetOpt
 
 if TYPE_CHECKING:
@@ -55,6 +57,9 @@ def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Param
         opt("json_path", JsonOpt, None),
         opt("record", RecordOpt, None),
         opt("record_episode", Annotated[int, typer.Option("--record-episode", min=0, help="Which episode --record films.")], 0),
+        opt("camera", CameraOpt, None),
+        opt("size", SizeOpt, None),
+        opt("fps", FpsOpt, None),
         opt("gui", GuiOpt, False),
         opt("quiet", QuietOpt, False),
         opt("min_success", Annotated[float, typer.Option("--min-success", min=0.0, max=1.0,
@@ -132,7 +137,8 @@ def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
 
 def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm: str | None, seed: int | None,
             episodes: int, json_path: Path | None, record: Path | None, record_episode: int, gui: bool,
-            quiet: bool, min_success: float, extras: Any, set_: list[str] | None = None) -> int:
+            quiet: bool, min_success: float, extras: Any, set_: list[str] | None = None, camera: str | None = None,
+            size: str | None = None, fps: float | None = None) -> int:
     """Check, run, write and print one ``run <kind>``; the exit code (0, 1 or 130)."""
     from robocfg.cli.common import console, load_task_for, write_json
     from robocfg.cli.episodes import (
@@ -151,12 +157,13 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
 
     kind = runner_type.kind
     check_record_episode(record_episode, episodes, record is not None)
+    recording = record_settings(camera, size, fps, record is not None)
     quiet_import()
     checked = load_task_for(task, kind, command_name(kind), robot, overrides(set_))
     out = console()
     log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
     options = RunOptions(seed=seed, episodes=episodes, arm=arm, gui=gui, record=record, record_episode=record_episode,
-                         extras=extras, log=log)
+                         recording=recording, extras=extras, log=log)
     runner = runner_type(checked, options)
     runner.check()  # exit 2 before anything is simulated
     hook = HOOKS.get(kind)

@@ -78,6 +78,7 @@ class RunOptions:
     record: Path | None = None  # picture file of one episode: .gif/.mp4 (animation), .png (last frame)
     record_episode: int = 0  # which episode ``record`` films
     recorder: RecorderFactory | None = None  # custom recorder for ``record_episode`` (overrides ``record``)
+    recording: Any = None  # robocfg.sim.record_settings.RecordSettings: --camera/--size/--fps of ``record``
     extras: Any = None  # the kind's own options: an instance of its ``Options`` dataclass, or None
     on_episode: Callable[[EpisodeOutcome], None] | None = None  # called with each finished episode record
     should_stop: Callable[[], bool] | None = None  # True once the run is asked to stop (SIGINT/SIGTERM)

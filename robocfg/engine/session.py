@@ -100,7 +100,8 @@ class EpisodeSession(ABC, Generic[RecordT]):
         """The picture recorder for ``--record PATH`` (default: the fitted scene camera)."""
         from robocfg.sim.record import Recorder
 
-        return Recorder(self.world, path)  # 10 fps: a frame costs ≈ 6 ms, 58 of them for a 5.8 s pick-place
+        # 10 fps: a frame costs ≈ 6 ms, 58 of them for a 5.8 s pick-place
+        return Recorder(self.world, path, settings=self.options.recording)
 
     # ---- the engine ------------------------------------------------------------------------
     def rng(self, k: int) -> np.random.Generator:

@@ -73,19 +73,19 @@ class FollowTargetRunner(TaskRunner):
         o, x = self.options, self.options.extras
         assert isinstance(x, FollowTargetOptions)
         return RunOutput(run_follow_target(self.task, gui=o.gui, with_obstacle=x.with_obstacle, record=o.record,
-                                           plot=x.plot, arm=o.arm, should_stop=o.should_stop))
+                                           plot=x.plot, arm=o.arm, should_stop=o.should_stop, recording=o.recording))
 
 
 def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool | None = None,
                       record: Path | None = None, plot: Path | None = None,
                       params: FollowTargetParams | None = None, realtime: bool | None = None,
-                      arm: str | None = None, should_stop=None) -> FollowTargetResult:
+                      arm: str | None = None, should_stop=None, recording=None) -> FollowTargetResult:
     """Run the follow-target task; returns the result, or raises RunFailed carrying it.
 
     ``with_obstacle`` overrides the task's switch; ``params`` overrides the task's
     ``follow_target`` block (benchmarks use it); ``realtime`` paces the loop to the wall clock
     (default: with ``gui``); ``should_stop`` (SIGINT) ends the loop early, the result marked
-    ``interrupted``.
+    ``interrupted``; ``recording``: the user's RecordSettings for ``record``.
     """
     from robocfg.motion.targets import TargetMotion
     from robocfg.sim.world import World
@@ -96,7 +96,8 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
     target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
                           params.orientation, math.radians(params.follow_angle_deg))
     with World(task, gui=gui) as world:
-        run = _FollowRun(task, world, params, target, RunOptions(gui=gui, record=record, arm=arm, should_stop=should_stop),
+        run = _FollowRun(task, world, params, target, RunOptions(gui=gui, record=record, arm=arm, should_stop=should_stop,
+                                                                     recording=recording),
                          params.with_obstacle if with_obstacle is None else with_obstacle)
         run.loop(gui if realtime is None else realtime)
         result = run.finish(plot, t_wall)
@@ -152,7 +153,7 @@ class _FollowRun:
             c = target.center
             view = CameraView(target=(float(c[0]) * 0.6, float(c[1]), float(c[2]) * 0.8), distance=1.5,
                               yaw_deg=60.0, pitch_deg=-25.0)
-            self.recorder = Recorder(world, options.record, fps=15.0, camera=view)
+            self.recorder = Recorder(world, options.record, fps=15.0, camera=view, settings=options.recording)
         self.series: list[tuple[float, float, float, float]] = []
         self.times: list[float] = []
         self.cpu: list[float] = []

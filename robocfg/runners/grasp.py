@@ -102,8 +102,8 @@ class GraspSession(EpisodeSession[GraspEpisode]):
         from robocfg.grasp.draw import GraspRecorder
         from robocfg.sim.record import CameraView
 
-        return GraspRecorder(self.world, path, fps=12.0, camera=CameraView(target=(0.5, 0.0, 0.08), distance=0.7,
-                                                                           yaw_deg=50.0, pitch_deg=-30.0))
+        view = CameraView(target=(0.5, 0.0, 0.08), distance=0.7, yaw_deg=50.0, pitch_deg=-30.0)
+        return GraspRecorder(self.world, path, fps=12.0, camera=view, settings=self.options.recording)
 
     def report(self, records: list[GraspEpisode], interrupted: bool) -> GraspReport:
         from robocfg.grasp.perception import camera_warnings

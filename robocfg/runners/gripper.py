@@ -104,13 +104,16 @@ class GripperRunner(TaskRunner):
 
     def run(self) -> RunOutput:
         o = self.options
-        return RunOutput(run_gripper(self.task, gui=o.gui, record=o.record, arm=o.arm, should_stop=o.should_stop))
+        return RunOutput(run_gripper(self.task, gui=o.gui, record=o.record, arm=o.arm, should_stop=o.should_stop,
+                                     recording=o.recording))
 
 
 def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None,
-                camera=None, fps: float = 10.0, arm: str | None = None, should_stop=None) -> GripperResult:
+                camera=None, fps: float = 10.0, arm: str | None = None, should_stop=None,
+                recording=None) -> GripperResult:
     """Run the gripper task; returns the result or raises RunFailed carrying it. ``should_stop``
-    (SIGINT) ends the run early with the result marked ``interrupted``."""
+    (SIGINT) ends the run early with the result marked ``interrupted``; ``recording``: the user's
+    RecordSettings for ``record``."""
     from robocfg.sim.record import Recorder, facing_camera
     from robocfg.sim.world import World
 
@@ -135,7 +138,7 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
             tcp = handle.tcp_pose()
             closing = tcp[:3, :3] @ np.asarray(handle.config.R_ee_graspnet)[1, :]  # grasp y in world
             view = camera or facing_camera(tcp[:3, 3], closing, world.robot.base_pose()[:3, 3], distance=0.35)
-            recorder = Recorder(world, record, fps=fps, camera=view)
+            recorder = Recorder(world, record, fps=fps, camera=view, settings=recording)
         run = _Run(world, params, result, recorder, arm_cfg.name)
         fingers = isinstance(g_cfg, ParallelGripperConfig)  # parallel and one-jaw: fingers that close
         if fingers:

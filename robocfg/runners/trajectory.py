@@ -149,7 +149,7 @@ class TrajectoryRunner(TaskRunner):
         o, x = self.options, self.options.extras
         no_sim = isinstance(x, TrajectoryOptions) and x.no_sim
         result = run_trajectory(self.task, gui=o.gui, record=o.record, follow=not no_sim, arm=o.arm,
-                                should_stop=o.should_stop)
+                                should_stop=o.should_stop, recording=o.recording)
         if isinstance(x, TrajectoryOptions) and x.plot is not None:
             plot_result(result, x.plot)
         return RunOutput(result)
@@ -211,10 +211,11 @@ def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
 
 def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = None,
                    follow: bool = True, fps: float = 15.0, arm: str | None = None,
-                   should_stop=None) -> TrajectoryResult:
+                   should_stop=None, recording=None) -> TrajectoryResult:
     """Plan and (if ``follow``) track the task's trajectory. Raises ConfigError for bad input,
     RunFailed (with the result so far) if a phase fails; ``should_stop`` (SIGINT) ends the
-    following early with the result marked ``interrupted``."""
+    following early with the result marked ``interrupted``; ``recording``: the user's
+    RecordSettings for ``record``."""
     from robocfg.motion.trajectory import check_limits
 
     t_wall = time.perf_counter()
@@ -241,12 +242,12 @@ def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = N
         result.success = check.total == 0
         result.wall_time = time.perf_counter() - t_wall
         return result
-    _follow(task, params, names, plan, result, gui, record, fps, should_stop)
+    _follow(task, params, names, plan, result, gui, record, fps, should_stop, recording)
     result.wall_time = time.perf_counter() - t_wall
     return result
 
 
-def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps, should_stop) -> None:
+def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps, should_stop, recording=None) -> None:
     from robocfg.motion.follower import follow
     from robocfg.sim.record import CameraView, Recorder
     from robocfg.sim.world import World
@@ -261,7 +262,7 @@ def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fp
         if record is not None:
             base = robot.base_pose()[:3, 3]
             view = CameraView(target=(float(base[0]) + 0.3, float(base[1]), float(base[2]) + 0.4), distance=1.5)
-            recorder = Recorder(world, record, fps=fps, camera=view)
+            recorder = Recorder(world, record, fps=fps, camera=view, settings=recording)
             recorder.capture()
         try:
             tr = follow(world, names, plan.trajectory, params.settle_time,

@@ -19,6 +19,7 @@ import pybullet as p
 
 from robocfg.errors import RobocfgError
 from robocfg.sim.record_overlay import FrameInfo, Marker, contact_sheet, draw_markers, draw_status
+from robocfg.sim.record_settings import RecordSettings
 from robocfg.sim.render_mirror import MAX_FACES, RenderMirror
 
 if TYPE_CHECKING:
@@ -65,6 +66,7 @@ class Recorder:
     overlay: bool = True
     max_faces: int | None = MAX_FACES
     renderer: str | None = None
+    settings: RecordSettings | None = None  # the user's camera / size / fps: override the run's choice
     frames: list[np.ndarray] = field(default_factory=list, init=False)
     infos: list[FrameInfo] = field(default_factory=list, init=False)
     markers: list[Marker] = field(default_factory=list, init=False)
@@ -82,11 +84,22 @@ class Recorder:
         self.sheet = kind == ".png" and self.path.stem.lower().endswith("sheet")
         self.animate = kind != ".png" or self.sheet
         self.markers = task_markers(self.world)
+        if self.settings is not None:
+            self._apply(self.settings)
         self.renderer = self.renderer or os.environ.get("ROBOCFG_RENDERER", "auto")
         if self.renderer not in RENDERERS:
             raise RobocfgError(f"unknown renderer {self.renderer!r}: one of {', '.join(RENDERERS)}")
         if self.camera is None:
             self.camera = scene_camera(self.world, self.size, self.markers)
+
+    def _apply(self, s: RecordSettings) -> None:
+        if s.size is not None:
+            self.size = s.size
+        if s.fps is not None:
+            self.fps = s.fps
+        if s.camera is not None:
+            c = s.camera
+            self.camera = CameraView(target=c.target, distance=c.distance, yaw_deg=c.yaw_deg, pitch_deg=c.pitch_deg)
 
     def view_projection(self) -> tuple[list[float], list[float]]:
         """PyBullet's (view, projection) matrices of the camera (column-major 16-lists)."""
