@@ -64,7 +64,11 @@ def test_arm_without_gripper_and_a_relative_urdf(tmp_path):
     robot = load_robot(out)
     assert robot.urdf_path == KR210_URDF.resolve()
     assert robot.config.arms[0].joints == [f"joint_a{i}" for i in range(1, 7)]
-    assert robot.config.arms[0].ee_link == "suction_cup"  # the deepest rigid link (no gripper joints)
+    # No gripper joints: the tool tip (the cup face, furthest from the wrist) measured from the deepest
+    # frame whose + axis points at it — the shipped kuka_kr210.yaml's ee_link, TCP and suction link.
+    assert robot.config.arms[0].ee_link == "tool0" and robot.config.arms[0].ee_axis == "z"
+    assert robot.config.arms[0].tcp_offset == pytest.approx(0.2, abs=1e-4)
+    assert d.suction_link == "suction_cup" and "# gripper: {type: suction, link: suction_cup" in out.read_text()
     lo = [robot.urdf.joints[j].lower for j in robot.config.arms[0].joints]
     hi = [robot.urdf.joints[j].upper for j in robot.config.arms[0].joints]
     assert all(a <= h <= b for a, h, b in zip(lo, robot.config.arms[0].home, hi, strict=True))

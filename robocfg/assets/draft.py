@@ -113,13 +113,13 @@ def draft_robot(urdf: Urdf, name: str, out_dir: Path, urdf_uri: str | None = Non
         except UnsupportedGripper as exc:
             notes.append(f"unsupported gripper: {exc}; write the gripper block by hand (type parallel, one_jaw or suction)")
     if found is None:
-        tip = tool_tip(urdf, resolver, ee_link, cands)
+        tip = tool_tip(urdf, resolver, cands)
         if not leaders:
             notes.append("no gripper joints below the arm: for a suction tool add `gripper: {type: suction, link: ...}` "
                          "(the draft names the tool link in a comment); tcp_offset is the tip of the tool's geometry "
                          "(a suction cup's face)")
         if tip is not None:
-            found, suction_link = tip
+            found, ee_link, suction_link = tip
         else:
             found = GripperGeometry(None, "z", 0.1)
             notes.append("no tool geometry: ee_axis z and tcp_offset 0.1 are placeholders")
@@ -129,8 +129,8 @@ def draft_robot(urdf: Urdf, name: str, out_dir: Path, urdf_uri: str | None = Non
                      "+x, +y or +z points at the fingertips")
         tcp = 0.1
     if gripper is not None:
-        notes.append(f"gripper max_force {gripper.max_force:g} is the URDF effort limit of {gripper.joints}: check it "
-                     "against the object (too much torque tilts linkage fingers)")
+        notes.append(f"gripper max_force {gripper.max_force:g} presses each pad with about 20 N (the lever from "
+                     f"{gripper.joints} to the pads; capped by the URDF effort): check it against the object's weight")
         notes.append(f"tcp_offset {tcp:.4f} m is the finger-pad midpoint with the gripper closed (as validate measures it); "
                      "grasp a test object and adjust")
     closing_sign = gripper.closing_sign if gripper else 1.0
@@ -276,7 +276,7 @@ def render_yaml(d: RobotDraft) -> str:
             lines += ["      # The fixed jaw's inner face across the ee_axis line, along the closing direction (m).",
                       f"      fixed_jaw_face: {_num(g.fixed_jaw_face)}"]
         lines += [
-            "      # CHECK: the URDF effort limit; linkage grippers often need much less.",
+            "      # CHECK: about 20 N per pad (the lever to the pads; capped by the URDF effort).",
             f"      max_force: {_num(g.max_force)}",
             "      lateral_friction: 1.0",
             "    collision_filter:",

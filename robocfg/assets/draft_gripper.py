@@ -38,6 +38,8 @@ AXES = "xyz"
 MIN_FINGER_SEPARATION = 0.005  # m: two pads closer than this across the approach axis are one side
 JAW_CONTACT = 0.005  # m: a jaw this close to the fixed jaw at one limit closes onto it
 JAW_MIN_OPENING = 0.015  # m: ... and opens at least this far at the other limit
+MIN_TOOL_TIP = 0.005  # m: a tool tip closer than this to the frame is the frame itself (tcp_offset must be > 0)
+PAD_FORCE = 20.0  # N per pad the drafted grip force aims at (a 1 kg object held by friction 0.5 needs 10)
 
 
 class UnsupportedGripper(Exception):
@@ -121,9 +123,25 @@ def _finger_pair(clouds: dict[str, np.ndarray], axis: int) -> list[str]:
     raise UnsupportedGripper(f"no two finger links on either side of the approach axis among {tips}")
 
 
-def _effort(urdf: Urdf, leaders: list[str]) -> float:
-    efforts = [urdf.joints[j].effort for j in leaders]
-    return float(min(e for e in efforts if e > 0)) if any(e > 0 for e in efforts) else 40.0
+def grip_force(urdf: Urdf, ee_link: str, leaders: list[str], pads: list[np.ndarray], q: dict[str, float]) -> float:
+    """Drive force (N) or torque (N·m) per leader that presses each pad with about ``PAD_FORCE``:
+    a prismatic leader pushes ``PAD_FORCE``; a revolute one ``PAD_FORCE`` × the lever from its axis
+    to the pads (ee frame, at ``q``). Capped by the URDF effort, which is often a motor's stall
+    value: 1000 N·m on the airo-models 2F-85, whose linkage tilts its fingers above ≈ 3 N·m."""
+    centres = [(P.min(axis=0) + P.max(axis=0)) / 2 for P in pads]
+    T_ee_inv = np.linalg.inv(urdf.link_pose(ee_link, q))
+    out = []
+    for name in leaders:
+        j = urdf.joints[name]
+        if j.type == "prismatic":
+            f = PAD_FORCE
+        else:
+            T = T_ee_inv @ urdf.link_pose(j.parent, q) @ j.origin
+            a, o = T[:3, :3] @ j.axis, T[:3, 3]
+            lever = max(float(np.linalg.norm(np.cross(c - o, a))) for c in centres)
+            f = PAD_FORCE * max(lever, 0.01)
+        out.append(min(f, j.effort) if j.effort > 0 else f)
+    return round(float(min(out)), 3)
 
 
 def _limits(urdf: Urdf, leaders: list[str]) -> tuple[dict[str, float], dict[str, float]]:
@@ -154,7 +172,8 @@ def parallel_gripper(urdf: Urdf, resolver: Resolver, ee_link: str, leaders: list
         closing = (axis + 1) % 3
     tcp = float(pad_midpoint(closed_pads)[axis])
     g = GripperDraft("parallel", leaders, [round(open_q[j], 6) for j in leaders], [round(closed_q[j], 6) for j in leaders],
-                     pair, round(max(max(gaps), 1e-3), 4), round(max(min(gaps), 0.0), 4), _effort(urdf, leaders), AXES[closing])
+                     pair, round(max(max(gaps), 1e-3), 4), round(max(min(gaps), 0.0), 4),
+                     grip_force(urdf, ee_link, leaders, closed_pads, closed_q), AXES[closing])
     return GripperGeometry(g, AXES[axis], tcp)
 
 
@@ -213,19 +232,34 @@ def _jaw_at(urdf: Urdf, resolver: Resolver, ee_link: str, joint: str, pair: list
     face = float((pads[1] @ unit).min())
     tcp = float(pad_midpoint(pads)[axis])
     g = GripperDraft("one_jaw", [joint], [round(open_q[joint], 6)], [round(closed_q[joint], 6)], pair,
-                     round(gap_open, 4), round(max(gap_closed, 0.0), 4), _effort(urdf, [joint]), AXES[closing],
+                     round(gap_open, 4), round(max(gap_closed, 0.0), 4), grip_force(urdf, ee_link, [joint], pads, closed_q), AXES[closing],
                      sign, round(face, 4))
     return GripperGeometry(g, AXES[axis], tcp)
 
 
-def tool_tip(urdf: Urdf, resolver: Resolver, ee_link: str, links: list[str]) -> tuple[GripperGeometry, str] | None:
-    """(ee axis and distance to the furthest point of the rigid links' geometry, the link it
-    belongs to), or None without geometry. For a suction tool that point is the cup face."""
-    clouds = link_points(urdf, resolver, ee_link, links, {})
+def tool_tip(urdf: Urdf, resolver: Resolver, cands: list[str]) -> tuple[GripperGeometry, str, str] | None:
+    """The tip of a tool without gripper joints, for a suction cup its face: (ee axis and distance
+    to it, the ee_link frame it is measured in, the link it belongs to), or None without geometry.
+
+    ``cands`` are the links rigid with the last arm joint, ``cands[0]`` the wrist link. The tip is
+    the point of their geometry furthest from the wrist's origin (a cup past the fingers of a
+    Kinova hand, the cup of a KR 210's tool). Its frame is the deepest link on the way to it along
+    one of whose + axes it lies (within half its distance of the axis line): a cup link whose
+    origin is its own face cannot measure it."""
+    wrist = cands[0]
+    clouds = link_points(urdf, resolver, wrist, cands, {})
     if not clouds:
         return None
-    best = max(((ln, k, float(P[:, k].max())) for ln, P in clouds.items() for k in range(3)), key=lambda t: t[2])
-    ln, k, d = best
-    if d <= 0:
-        return None
-    return GripperGeometry(None, AXES[k], d), ln
+    owners = [ln for ln, P in clouds.items() for _ in range(len(P))]
+    P = np.concatenate(list(clouds.values()))
+    i = int(np.argmax(np.linalg.norm(P, axis=1)))
+    owner = owners[i]
+    path = [ln for ln in cands if urdf.chain(ln, owner) is not None]
+    for frame in sorted(path, key=lambda ln: -len(urdf.chain(wrist, ln) or [])):
+        T = np.linalg.inv(urdf.link_pose(frame)) @ urdf.link_pose(wrist)
+        p = T[:3, :3] @ P[i] + T[:3, 3]
+        k = int(np.argmax(p))
+        tip, lateral = float(p[k]), float(np.linalg.norm(np.delete(p, k)))
+        if tip > MIN_TOOL_TIP and lateral <= 0.5 * tip:
+            return GripperGeometry(None, AXES[k], tip), frame, owner
+    return None
