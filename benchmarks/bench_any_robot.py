@@ -75,6 +75,13 @@ def use_suction_hint(yaml_path: Path) -> bool:
     return False
 
 
+def _general(reason: str) -> str:
+    """A failure reason with its numbers blanked, so episodes failing the same way count once."""
+    import re
+
+    return re.sub(r"-?\d+(\.\d+)?", "#", reason or "")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--episodes", type=int, default=20)
@@ -98,12 +105,18 @@ def main() -> None:
                 row["validate"] = code
                 row["validate_warnings"] = [ln for ln in text.splitlines() if "warning:" in ln]
                 for cmd in ("gripper", "trajectory", "follow-target"):
-                    code, text, wall = robocfg(["run", cmd, "--robot", str(out), "-q"], folder)
-                    row[cmd] = {"exit": code, "result": text.splitlines()[-1] if text else "", "wall_s": round(wall, 1)}
+                    rep = folder / f"{name}_{cmd}.json"
+                    code, text, wall = robocfg(["run", cmd, "--robot", str(out), "-q", "--json", str(rep)], folder)
+                    r = json.loads(rep.read_text()) if rep.exists() else {}
+                    ok = code == 0 and bool(r.get("success")) and r.get("reached", True) is not False
+                    why = r.get("reason") or r.get("unreachable_reason") or (text.splitlines()[-1] if text and not ok else "")
+                    row[cmd] = {"exit": code, "ok": ok, "why": f"{r.get('failed_phase') or ''}: {why}".strip(": "),
+                                "wall_s": round(wall, 1)}
                 rep = folder / f"{name}_pp.json"
                 code, text, wall = robocfg(["run", "pick-place", "--robot", str(out), "-n", str(args.episodes), "--json", str(rep), "-q"], folder)
                 summary = json.loads(rep.read_text())["summary"] if rep.exists() else {}
-                reasons = sorted({ln for ln in text.splitlines() if ln.startswith("failed")})
+                episodes = json.loads(rep.read_text())["episodes"] if rep.exists() else []
+                reasons = sorted({f"{e['failed_phase']}: {_general(e['reason'])}" for e in episodes if not e["success"]})
                 row["pick_place"] = {"exit": code, "success": f"{summary.get('successes', 0)}/{summary.get('episodes', args.episodes)}",
                                      "failures_by_phase": summary.get("failures_by_phase", {}), "reasons": reasons[:4],
                                      "wall_s": round(wall, 1)}
@@ -114,10 +127,16 @@ def main() -> None:
     for r in rows:
         def ok(key: str, r: dict = r) -> str:
             v = r.get(key)
-            return "—" if v is None else ("ok" if v["exit"] == 0 else "FAIL")
+            return "—" if v is None else ("ok" if v["ok"] else "FAIL")
         pp = r.get("pick_place", {})
         print(f"{r['robot']:<14} | {'ok' if r['new_robot'] == 0 else 'FAIL':<9} | {'ok' if r.get('validate') == 0 else 'FAIL':<8} | "
               f"{ok('gripper'):<7} | {ok('trajectory'):<10} | {ok('follow-target'):<13} | {pp.get('success', '—')} {pp.get('failures_by_phase', '')}")
+    for r in rows:
+        for key in ("gripper", "trajectory", "follow-target"):
+            if key in r and not r[key]["ok"]:
+                print(f"  {r['robot']} {key}: {r[key]['why']}")
+        for reason in r.get("pick_place", {}).get("reasons", []):
+            print(f"  {r['robot']} pick-place: {reason}")
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
 
