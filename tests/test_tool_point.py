@@ -16,6 +16,7 @@ DATA = ROOT / "tests" / "data"
 def _variant(tmp_path: Path, src: Path, old: str, new: str) -> Path:
     text = src.read_text()
     assert old in text
+    tmp_path.mkdir(parents=True, exist_ok=True)
     out = tmp_path / src.name
     out.write_text(text.replace(old, new))
     for f in src.parent.glob("*.urdf"):
@@ -53,3 +54,24 @@ def test_failed_grasp_names_tcp_offset_against_the_closed_pads(tmp_path):
     good = load_robot(shipped)
     hint = grasp_failure_hint(good.urdf, Resolver(good.path.parent), good.config.arms[0], ["finger_joint"], 0.05)
     assert "tcp_offset" not in hint and "max_force 1" in hint
+
+
+def test_links_without_inertial_load_light_not_as_1_kg(tmp_path):
+    """tool0 (a bare frame under a fixed joint) has no <inertial>: validate warns and PyBullet gets
+    0.001 kg, not its 1 kg default; a link_masses entry wins."""
+    import pybullet as p
+    import yaml
+    from _sim_helpers import make_task
+
+    from robocfg.sim.world import World
+
+    src = DATA / "sim_onejaw_robot.yaml"
+    bare = _variant(tmp_path, src, "  link_masses:\n    tool0: 0.001\n", "")
+    robot = load_robot(bare)
+    [w] = robot.warnings
+    assert "'tool0' has no <inertial>" in w.message and "0.001 kg" in w.message
+    for path, want in ((bare, 0.001), (_variant(tmp_path / "given", src, "tool0: 0.001", "tool0: 0.25"), 0.25)):
+        with World(make_task(tmp_path, path)) as world:
+            r = world.robot
+            assert p.getDynamicsInfo(r.body_id, r.link("tool0"), physicsClientId=r.client)[0] == want
+    assert yaml.safe_load(src.read_text())["physics"]["link_masses"] == {"tool0": 0.001}
