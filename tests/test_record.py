@@ -94,3 +94,28 @@ def test_unknown_suffix_is_refused(kr210_world):
 
     with pytest.raises(RobocfgError, match=r"\.gif, \.mp4 or \.png"):
         Recorder(kr210_world, "x.avi")
+
+
+def test_gripper_and_grasp_recordings_name_their_phases_and_outcome(tmp_path, monkeypatch):
+    from robocfg.engine import EpisodeObserver, RunOptions, run
+    from robocfg.runners.gripper import run_gripper
+
+    seen: list[str] = []
+    monkeypatch.setattr(Recorder, "set_phase", lambda self, name: seen.append(name))
+    res = run_gripper(load_task(catalog.find("tasks", "gripper")), record=tmp_path / "g_sheet.png")
+    assert res.success and seen[:2] == ["close", "open"] and {"grasp", "hold", "release"} <= set(seen)
+
+    class Spy(EpisodeObserver):
+        def __init__(self):
+            self.phases, self.outcome = [], None
+
+        def set_phase(self, name):
+            self.phases.append(name)
+
+        def finish(self, success, reason=""):
+            self.outcome = (success, reason)
+
+    spy = Spy()
+    run(load_task(catalog.find("tasks", "grasp")), RunOptions(seed=0, recorder=lambda world: spy))
+    assert spy.phases[0] == "plan" and {"approach", "grasp", "lift"} <= set(spy.phases)
+    assert spy.outcome == (True, "")  # the session reports the outcome to the recorder

@@ -120,6 +120,9 @@ class _Episode:
     def _plan(self, attempt: int) -> Candidate:
         from robocfg.grasp.perception import perceive
 
+        if self.recorder is not None:
+            self.recorder.set_phase("plan")
+
         p, ctx = self.params, self.ctx
         t0 = time.perf_counter()
         per = perceive(self.world, p, self.rng)
@@ -228,6 +231,8 @@ class _Episode:
 
     def _phase(self, name: str, what: str) -> None:
         self.mover.phase = name
+        if self.recorder is not None:
+            self.recorder.set_phase(name)
         self.log(f"Phase {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
 
     def _on_step(self) -> None:

@@ -44,6 +44,11 @@ class _Run:
     def width(self) -> float | None:
         return self.gripper.width()
 
+    def phase(self, name: str) -> None:
+        """Name the phase under way (recordings label their frames with it)."""
+        if self.recorder is not None:
+            self.recorder.set_phase(name)
+
     def run_for(self, seconds: float, each=None) -> float:
         """Step for ``seconds``; returns the worst mimic error seen."""
         w, worst = self.world, 0.0
@@ -69,6 +74,7 @@ class _Run:
         w, g = self.world, self.gripper
         t0, k0 = w.t, len(self.result.samples)
         w_start = self.width()
+        self.phase(phase if self.params.cycles == 1 or phase not in ("close", "open") else f"{phase} {cycle + 1}")
         command()
         err = self.run_for(self.move_time())
         widths = [s[1] for s in self.result.samples[k0:]]
@@ -158,6 +164,7 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
             result.sim_time = world.t
             result.wall_time = time.perf_counter() - t_wall
             if recorder is not None:
+                recorder.finish(result.success, "" if result.success else f"{result.failed_phase}: {result.reason}")
                 result.record = str(recorder.save())
     return result
 
@@ -274,6 +281,7 @@ def _hold_test(run: _Run) -> None:
     if not grasp_before:
         raise RunFailed("grasp", f"the fingers do not both touch {name!r} after closing (width {_mm(width_on)})")
     _lower_support(run, support)
+    run.phase("hold")
     run.run_for(HOLD_WAIT)
     hold.drop = float(z0 - w.body_pose(name)[0][2])
     hold.grasping_after = g.is_grasping(name)
@@ -307,6 +315,7 @@ def _suction(run: _Run) -> None:
     if not hold.grasping_before:
         raise RunFailed("grasp", f"suction did not attach {name!r}")
     _lower_support(run, support)
+    run.phase("hold")
     run.run_for(HOLD_WAIT)
     hold.drop = float(z0 - w.body_pose(name)[0][2])
     hold.grasping_after = g.is_grasping(name)
