@@ -225,3 +225,13 @@ def test_bad_option_values_are_named_by_their_option(capsys, monkeypatch):
     for args, start in cases:
         code, out, err = run_main(args, capsys, monkeypatch)
         assert code == 2 and err.startswith(start) and "Traceback" not in out + err, (args, err)
+
+
+def test_every_summary_fits_one_line_of_a_plain_terminal(capsys, monkeypatch):
+    root = typer.main.get_command(app)
+    groups = [(), *[p for p, cmd in _commands(root) if hasattr(cmd, "commands")]]
+    for path in groups:
+        code, out, _ = run_main([*path, "--help"], capsys, monkeypatch)
+        listing = out.split("Commands:\n", 1)[1].splitlines()
+        wrapped = [line for line in listing if line.startswith(" " * 5)]  # a continuation line
+        assert code == 0 and not wrapped, (path, out)

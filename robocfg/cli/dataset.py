@@ -15,7 +15,7 @@ DirArg = Annotated[Path, typer.Argument(help="Dataset directory (LeRobot v3.0) o
 
 @dataset_app.command("info")
 def info(path: DirArg, json_path: JsonOpt = None) -> int:
-    """Episodes, frames, features (name and shape) and success rate of a dataset."""
+    """Summarise a dataset. Episodes, frames, features (name and shape) and success rate."""
     from robocfg.datasets.read import read_info
 
     d = read_info(path)

@@ -31,8 +31,8 @@ def import_interndata(
                                                     "optional when the file has a robocfg: block.")] = None,
     force: ForceOpt = False,
 ) -> None:
-    """Convert an InternDataEngine robot config into a robocfg robot YAML. Lists what was dropped
-    and why, and validates the result. Errors point at lines of THEIR file. Exit 0 written, 2 invalid."""
+    """Convert an InternDataEngine robot config into a robot YAML. Lists what was dropped and why,
+    and validates the result. Errors point at lines of THEIR file. Exit 0 written, 2 invalid."""
     from robocfg.interop.interndata_import import import_interndata as convert
 
     _refuse_overwrite(output, force)

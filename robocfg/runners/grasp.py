@@ -130,7 +130,7 @@ class GraspRunner(EpisodicRunner):
     report = GraspReport
     Options = GraspOptions
     verb = "lifted"
-    summary = ("Grasp objects with grasps planned from simulated depth cameras. Perceive the object with RGB-D "
+    summary = ("Grasp objects, planning from simulated depth cameras. Perceive the object with RGB-D "
                "cameras, plan antipodal grasps on the point cloud, execute the best, lift, shake and verify; "
                "retry the next-ranked grasp on failure.")
     description = (

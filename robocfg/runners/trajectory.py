@@ -135,7 +135,7 @@ class TrajectoryRunner(TaskRunner):
     params = TrajectoryParams
     report = TrajectoryResult
     Options = TrajectoryOptions
-    summary = ("Plan a time-optimal trajectory through the task's waypoints and track it. toppra; trapezoids "
+    summary = ("Plan a time-optimal trajectory and track it. toppra; trapezoids "
                "with stop_at_waypoints; ruckig with a jerk limit; checked against the limits at 1 kHz, tracked "
                "in PyBullet. Prints duration, planning time, violations and tracking error.")
 
