@@ -3,6 +3,7 @@ obstacle task (held cube attached to the hand's collision model), and nothing to
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 from _sim_helpers import ContactSpy
 
@@ -63,3 +64,28 @@ def test_place_behind_a_wall_fails_transport_naming_the_wall(task):
     assert episode.reason.startswith("the goal configuration is in collision (panda_link")
     assert "with wall" in episode.reason
     assert spy.robot_hits == 0 and spy.cube_hits == 0
+
+
+def test_a_loose_object_in_the_way_is_gone_round_not_pushed(task):
+    """The wall as a loose 2 kg block (``scene.objects``): the planner keeps the arm and the cube
+    clear of it where it stands, so it is never touched and stays put."""
+    scene = task.config.scene
+    wall = scene.obstacles[0]
+    block = wall.model_copy(update={"name": "block", "mass": 2.0})
+    loose = replace(task, config=task.config.model_copy(update={"scene": scene.model_copy(update={"obstacles": [], "objects": [block]})}))
+    spies = []
+
+    class BlockSpy(ContactSpy):
+        def maybe_capture(self):
+            super().maybe_capture()
+            self.block_at = self.world.body_pose("block")[0]
+
+    def factory(world):
+        spies.append(BlockSpy(world, obstacle="block"))
+        return spies[-1]
+
+    report, _ = run_pick_place(loose, episodes=1, seed=0, record=factory)
+    episode = report.episodes[0]
+    assert episode.success, (episode.failed_phase, episode.reason)
+    assert spies[0].checked > 500 and spies[0].robot_hits == 0 and spies[0].cube_hits == 0
+    assert np.allclose(spies[0].block_at, block.position, atol=1e-3)

@@ -11,6 +11,7 @@ from _sim_helpers import PANDA
 
 from robocfg.checks import load_robot
 from robocfg.collision import EnvShape, robot_geometry
+from robocfg.config import catalog
 from robocfg.kinematics.model import KinematicModel
 from robocfg.motion.limits import make_limits
 from robocfg.planning import JointPlanner, PlannerSettings, PlanningFailed
@@ -168,3 +169,22 @@ def test_exhausted_budget_fails_with_the_budget_in_ms(panda, wall_query):
     planner = JointPlanner(_checker(panda, [WALL]), kin.lower, kin.upper, PlannerSettings(budget_ms=1.0))
     with pytest.raises(PlanningFailed, match=r"^no collision-free path found in 1 ms \(\d+ collision checks\)$"):
         planner.plan(qs, qg)
+
+
+def test_a_goal_past_a_full_turn_is_brought_next_to_the_start_and_reached():
+    """UR5e joints span ±2π: an IK answer one turn away (the same pose) is planned to the
+    equivalent angle next to the start, and the search box stays within π of start and goal."""
+    robot = load_robot(catalog.find("robots", "ur5e_robotiq_2f85"))
+    kin = KinematicModel.from_robot(robot)
+    planner = JointPlanner(CollisionChecker(kin, robot_geometry(robot)[0], [GROUND]), kin.lower, kin.upper)
+    qs = np.array(kin.home, float)
+    qg = qs + np.array([0.3, 0.0, 0.0, 0.0, 0.0, 2 * np.pi - 0.2])  # wrist 3: one turn minus 0.2 rad away
+    assert kin.within_limits(qg)
+    near = planner.nearest_turn(qg, qs)
+    assert near[5] == pytest.approx(qs[5] - 0.2) and near[0] == pytest.approx(qg[0])
+    assert np.allclose(kin.fk(near), kin.fk(qg), atol=1e-9)  # the same TCP pose
+    path = planner.plan(qs, qg)
+    assert np.allclose(path.waypoints[-1], near) and path.length < 1.0
+    lo, hi = planner.search_box(qs, near)
+    assert np.all(lo >= kin.lower) and np.all(hi <= kin.upper)
+    assert hi[5] - lo[5] == pytest.approx(0.2 + 2 * np.pi)  # [min − π, max + π] for a ±2π joint

@@ -157,6 +157,13 @@ class CollisionChecker:
         self._held = {k: v - (v > gid) for k, v in self._held.items()}
         self._rebuild_pairs()
 
+    def move_shape(self, name: str, pose: np.ndarray) -> None:
+        """Put scene shape ``name`` at ``pose`` (4×4, world), e.g. a loose object that was pushed."""
+        from robocfg.collision.shapes import set_environment_pose
+
+        self.env[name].pose = np.asarray(pose, float)
+        set_environment_pose(self.geom, self.env_ids[name], pose)
+
     @property
     def held(self) -> list[str]:
         return list(self._held)

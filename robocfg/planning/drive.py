@@ -41,6 +41,7 @@ class PlannedDrive:
     kin: KinematicModel
     ee_link: str
     skipped: list[str]  # scene bodies the planner cannot see (meshes)
+    loose: list[str] = field(default_factory=list)  # scene.objects avoided where they lie at each move
     paths: list[PlannedPath] = field(default_factory=list)
 
     @property
@@ -59,6 +60,15 @@ class PlannedDrive:
 
     def detach(self, name: str) -> None:
         self.checker.detach(name)
+
+    def refresh_loose(self, world: World) -> None:
+        """Move the loose objects of the collision model to where they lie in ``world`` now."""
+        from robocfg.geometry import pose_to_matrix
+
+        for name in self.loose:
+            if name in world.bodies:
+                pos, quat = world.body_pose(name)
+                self.checker.move_shape(name, pose_to_matrix(pos, quat))
 
     def goal(self, mover: ArmMover, T_goal: np.ndarray, q0: np.ndarray) -> np.ndarray:
         """A collision-free IK answer for ``T_goal`` (EE, world): the one nearest ``q0`` if it is
@@ -83,6 +93,7 @@ class PlannedDrive:
 
     def move(self, mover: ArmMover, T_goal: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
         """Move ``mover``'s arm to ``T_goal`` (EE, world) along a planned collision-free path."""
+        self.refresh_loose(mover.world)
         q0 = mover.arm.joint_positions()
         q_goal = self.goal(mover, T_goal, q0)
         try:
@@ -105,13 +116,23 @@ class PlannedDrive:
 
 def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
                         settings: PlannerSettings = PlannerSettings(), margin: float | None = None) -> PlannedDrive:
-    """Planner for the arm of ``kin`` (a KinematicModel of ``robot``) among ``world``'s task scene
-    (ground, table, pedestal, obstacles; movable objects are not avoided)."""
+    """Planner for the arm of ``kin`` (a KinematicModel of ``robot``) among ``world``'s task scene:
+    ground, table, pedestal, obstacles, fixture parts, and the loose ``scene.objects`` (avoided
+    where they lie when each move starts; the object being picked is not among them)."""
     from robocfg.collision import robot_geometry
-    from robocfg.motion.reactive.setup import scene_shapes
+    from robocfg.motion.reactive.setup import body_shape, scene_shapes
     from robocfg.planning.checker import DEFAULT_MARGIN
 
     links, _ = robot_geometry(robot)
-    env, skipped = scene_shapes(world.task.config.scene)
+    scene = world.task.config.scene
+    env, skipped = scene_shapes(scene)
+    loose = []
+    for obj in scene.objects:  # neighbours in clutter: kept clear of like obstacles
+        shape = body_shape(obj)
+        if shape is None:
+            skipped.append(obj.name)
+        else:
+            env.append(shape)
+            loose.append(obj.name)
     checker = CollisionChecker(kin, links, env, DEFAULT_MARGIN if margin is None else margin)
-    return PlannedDrive(JointPlanner(checker, kin.lower, kin.upper, settings), kin, kin.ee_link, skipped)
+    return PlannedDrive(JointPlanner(checker, kin.lower, kin.upper, settings), kin, kin.ee_link, skipped, loose)

@@ -121,7 +121,7 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         warnings = [w.format() for w in self.task.warnings]
         warnings += [f"obstacle {name!r} is a mesh: the reactive controller does not avoid it" for name in skipped]
         unseen = self.tools.planned.skipped if self.tools.planned is not None else []
-        warnings += [f"obstacle {name!r} is a mesh: the planner does not avoid it" for name in unseen]
+        warnings += [f"body {name!r} is a mesh: the planner does not avoid it" for name in unseen]
         return PickPlaceReport(task=str(self.task.path), robot=self.task.robots[0].config.name,
                                arm=self.arm_cfg.name, seed=self.seed, summary=summarise(records), episodes=records,
                                warnings=warnings, interrupted=interrupted)
