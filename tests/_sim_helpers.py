@@ -51,3 +51,17 @@ class ContactSpy(EpisodeObserver):
 
     def save(self):
         pass
+
+
+def run_spied(task, make_spy, seed: int = 0, episodes: int = 1):
+    """Run pick-place with ``make_spy(world)`` recording episode 0; (report, that spy)."""
+    from robocfg.runners.pick_place import run_pick_place
+
+    spies = []
+
+    def factory(world):
+        spies.append(make_spy(world))
+        return spies[-1]
+
+    report, _ = run_pick_place(task, episodes=episodes, seed=seed, record=factory)
+    return report, spies[0]

@@ -6,14 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
-from _sim_helpers import ContactSpy
+from _sim_helpers import ContactSpy, run_spied
 
 from robocfg.checks import load_task
 from robocfg.config import catalog
 from robocfg.config.scene import Scene
 from robocfg.errors import ConfigError
 from robocfg.motion.reactive.setup import scene_shapes
-from robocfg.runners.pick_place import run_pick_place
 
 BIN = {"type": "bin", "name": "bin_a", "size": [0.3, 0.4, 0.08], "wall": 0.01, "position": [0.45, -0.25, 0.0]}
 
@@ -102,16 +101,10 @@ class _BinSpy(ContactSpy):
 
 
 def test_bin_to_bin_places_the_cube_without_touching_a_bin(bins):
-    spies = []
-
-    def factory(world):
-        spies.append(_BinSpy(world, obstacle="bin_a/floor"))
-        return spies[-1]
-
-    report, _ = run_pick_place(bins, episodes=1, seed=2, record=factory)
+    report, spy = run_spied(bins, lambda world: _BinSpy(world, obstacle="bin_a/floor"), seed=2)
     episode = report.episodes[0]
     assert episode.success, (episode.failed_phase, episode.reason)
     assert episode.object_final[1] > 0.05 + 0.01  # inside bin_b (its -y wall is at y = 0.05)
     assert episode.object_final[2] == pytest.approx(0.01 + 0.025, abs=0.005)  # on bin_b's floor
-    assert spies[0].checked > 500 and spies[0].robot_hits == 0
+    assert spy.checked > 500 and spy.robot_hits == 0
     assert np.isfinite(episode.place_error)

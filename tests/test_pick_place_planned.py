@@ -5,11 +5,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from _sim_helpers import ContactSpy
+from _sim_helpers import ContactSpy, run_spied
 
 from robocfg.checks import load_task
 from robocfg.config import catalog
-from robocfg.runners.pick_place import run_pick_place
 
 
 @pytest.fixture(scope="module")
@@ -24,14 +23,7 @@ def test_the_planned_task_is_the_obstacle_scene(task):
 
 
 def _run(task, seed: int, episodes: int = 1):
-    spies = []
-
-    def factory(world):
-        spies.append(ContactSpy(world))
-        return spies[-1]
-
-    report, _ = run_pick_place(task, episodes=episodes, seed=seed, record=factory)
-    return report, spies[0]
+    return run_spied(task, ContactSpy, seed, episodes)
 
 
 @pytest.mark.parametrize("seed", [0, 3])
@@ -73,19 +65,14 @@ def test_a_loose_object_in_the_way_is_gone_round_not_pushed(task):
     wall = scene.obstacles[0]
     block = wall.model_copy(update={"name": "block", "mass": 2.0})
     loose = replace(task, config=task.config.model_copy(update={"scene": scene.model_copy(update={"obstacles": [], "objects": [block]})}))
-    spies = []
 
     class BlockSpy(ContactSpy):
         def maybe_capture(self):
             super().maybe_capture()
             self.block_at = self.world.body_pose("block")[0]
 
-    def factory(world):
-        spies.append(BlockSpy(world, obstacle="block"))
-        return spies[-1]
-
-    report, _ = run_pick_place(loose, episodes=1, seed=0, record=factory)
+    report, spy = run_spied(loose, lambda world: BlockSpy(world, obstacle="block"))
     episode = report.episodes[0]
     assert episode.success, (episode.failed_phase, episode.reason)
-    assert spies[0].checked > 500 and spies[0].robot_hits == 0 and spies[0].cube_hits == 0
-    assert np.allclose(spies[0].block_at, block.position, atol=1e-3)
+    assert spy.checked > 500 and spy.robot_hits == 0 and spy.cube_hits == 0
+    assert np.allclose(spy.block_at, block.position, atol=1e-3)
