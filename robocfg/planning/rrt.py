@@ -42,17 +42,12 @@ class RRTResult:
     stopped_by: str  # "solved" | "checks" | "budget"
 
 
-_seeded = False
-
-
 def _rewind_ompl_rng() -> None:
     """Make the next OMPL random generators start from the same seeds as the first query's."""
-    global _seeded
     from ompl import util as ou
 
     ou.setLogLevel(ou.LOG_NONE)  # the rewind logs "changing seed now will not ..." as an error
     ou.RNG.setSeed(OMPL_SEED)
-    _seeded = True
 
 
 def rrt_connect(checker: CollisionChecker, q_start: np.ndarray, q_goal: np.ndarray,
