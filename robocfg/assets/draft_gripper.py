@@ -126,7 +126,8 @@ def _finger_pair(clouds: dict[str, np.ndarray], axis: int) -> list[str]:
 def grip_force(urdf: Urdf, ee_link: str, leaders: list[str], pads: list[np.ndarray], q: dict[str, float]) -> float:
     """Drive force (N) or torque (N·m) per leader that presses each pad with about ``PAD_FORCE``:
     a prismatic leader pushes ``PAD_FORCE``; a revolute one ``PAD_FORCE`` × the lever from its axis
-    to the pads (ee frame, at ``q``). Capped by the URDF effort, which is often a motor's stall
+    to the pads (ee frame, at ``q``); plus the joint's ``<dynamics>`` friction and its damping at
+    the rated velocity. Capped by the URDF effort, which is often a motor's stall
     value: 1000 N·m on the airo-models 2F-85, whose linkage tilts its fingers above ≈ 3 N·m."""
     centres = [(P.min(axis=0) + P.max(axis=0)) / 2 for P in pads]
     T_ee_inv = np.linalg.inv(urdf.link_pose(ee_link, q))
@@ -140,6 +141,9 @@ def grip_force(urdf: Urdf, ee_link: str, leaders: list[str], pads: list[np.ndarr
             a, o = T[:3, :3] @ j.axis, T[:3, 3]
             lever = max(float(np.linalg.norm(np.cross(c - o, a))) for c in centres)
             f = PAD_FORCE * max(lever, 0.01)
+        # What the joint's own <dynamics> take before the pads feel anything: its friction, and
+        # its damping at the rated speed (Unitree Z1's jaw: 1 N·m + 1 N·m·s/rad × 3.14 rad/s).
+        f += j.friction + j.damping * j.velocity
         out.append(min(f, j.effort) if j.effort > 0 else f)
     return round(float(min(out)), 3)
 

@@ -72,6 +72,8 @@ class Joint:
     velocity: float
     mimic: Mimic | None
     urdf_index: int  # position among all joints (PyBullet joint index)
+    damping: float = 0.0  # <dynamics damping>: N·m·s/rad (N·s/m), which PyBullet applies
+    friction: float = 0.0  # <dynamics friction>: N·m (N)
 
     @property
     def movable(self) -> bool:
@@ -286,7 +288,7 @@ def parse_urdf(path: Path) -> Urdf:
             axis = np.array(_floats(axis_el.get("xyz") if axis_el is not None else None, 3)) if axis_el is not None else np.array([1.0, 0, 0])
             if jtype in MOVABLE and np.linalg.norm(axis) > 0:
                 axis = axis / np.linalg.norm(axis)
-            parent, child = el.find("parent"), el.find("child")
+            parent, child, dyn = el.find("parent"), el.find("child"), el.find("dynamics")
             joints[el.get("name", "")] = Joint(
                 name=el.get("name", ""),
                 type=jtype,
@@ -300,6 +302,8 @@ def parse_urdf(path: Path) -> Urdf:
                 velocity=float(limit.get("velocity", 0)) if limit is not None else 0.0,
                 mimic=mimic,
                 urdf_index=i,
+                damping=float(dyn.get("damping", 0)) if dyn is not None else 0.0,
+                friction=float(dyn.get("friction", 0)) if dyn is not None else 0.0,
             )
     except (ValueError, TypeError) as exc:
         raise UrdfParseError(f"bad value: {exc}") from None

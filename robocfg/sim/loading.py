@@ -6,6 +6,8 @@
   mass); every other link without ``<inertial>`` (the root excepted) gets a small one too —
   ``missing_link_mass``: 0.01 kg with collision geometry, 0.001 kg for a bare frame — where
   PyBullet would load it as 1 kg (``robocfg validate`` warns about each such link).
+* Markedly concave collision meshes of one-jaw gripper jaws are replaced by their convex decomposition
+  (``robocfg.sim.concave``; PyBullet collides with a mesh's convex hull).
 * PyBullet's C-level messages are captured; a mesh PyBullet cannot read (it then silently loads the
   link with no collision shape) or cannot find raises ConfigError naming the mesh.
 """
@@ -48,6 +50,7 @@ def prepared_urdf(robot: CheckedRobot) -> Path:
                 mesh.set("filename", str(resolved))
                 changed = True
     changed |= _split_multi_material_visuals(root)
+    changed |= _decompose_finger_meshes(root, robot)
     children = {c.get("link") for j in root.findall("joint") for c in j.findall("child")}
     for link in root.findall("link"):
         name = link.get("name", "")
@@ -75,6 +78,33 @@ def prepared_urdf(robot: CheckedRobot) -> Path:
         tmp.write_text(text)
         tmp.replace(out)
     return out
+
+
+def _decompose_finger_meshes(root: ET.Element, robot: CheckedRobot) -> bool:
+    """Point the collision meshes of one-jaw finger links that are markedly concave at their convex
+    decomposition (``robocfg.sim.concave``): PyBullet would collide with one hull filling the
+    space between the jaws."""
+    from robocfg.config.robot import OneJawGripperConfig
+    from robocfg.sim.concave import convex_parts
+
+    # One-jaw grippers only: their fixed jaw is typically part of the hand's mesh. Two-finger
+    # grippers keep PyBullet's hulls (their physics, and the shipped robots' figures, unchanged).
+    fingers = {f for arm in robot.config.arms if isinstance(arm.gripper, OneJawGripperConfig)
+               for f in arm.gripper.finger_links}
+    changed = False
+    for link in root.findall("link"):
+        if link.get("name") not in fingers:
+            continue
+        for mesh in link.findall("collision/geometry/mesh"):
+            fn = Path(mesh.get("filename", ""))
+            if not fn.is_absolute() or not fn.is_file():
+                continue
+            v = [float(x) for x in (mesh.get("scale") or "1 1 1").split()]
+            parts = convex_parts(fn, (v[0], v[1], v[2]) if len(v) == 3 else (1.0, 1.0, 1.0))
+            if parts is not None:
+                mesh.set("filename", str(parts))
+                changed = True
+    return changed
 
 
 def _massless(link: ET.Element) -> bool:
