@@ -7,17 +7,15 @@ before each episode (the gripper's box model is measured once, before the snapsh
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from robocfg.config.commands import GraspParams, Limits
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.engine.options import FrameRecorder, RunOptions, option
+from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.errors import ConfigError, Problem, RobocfgError
@@ -30,21 +28,8 @@ __all__ = ["EpisodeFailed", "EpisodeSetup", "GraspRunner", "episode_setup", "epi
 
 def episode_setup(params: GraspParams, seed: int, k: int) -> EpisodeSetup:
     """Episode k: ``objects[k % n]`` moved by ``randomize`` with ``default_rng([seed, k])``."""
-    from robocfg.geometry import matrix_to_quat, quat_to_matrix
-
-    rz = params.randomize
-    obj = params.objects[k % len(params.objects)]
-    rng = episode_rng(seed, k)
-    dx, dy = rng.uniform(-1, 1, 2) * np.asarray(rz.xy_range)
-    dyaw = math.radians(rng.uniform(-1, 1) * rz.yaw_range_deg)
-    c, s_ = math.cos(dyaw), math.sin(dyaw)
-    Rz = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
-    quat = matrix_to_quat(Rz @ quat_to_matrix(obj.quaternion_xyzw()))
-    body = obj.model_copy(update={
-        "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
-        "euler_deg": None, "quat_wxyz": None, "quat_xyzw": [float(v) for v in quat],
-    })
-    return EpisodeSetup(k, seed + k, body, dyaw)
+    placed = place_randomly(params.objects[k % len(params.objects)], params.randomize, episode_rng(seed, k))
+    return EpisodeSetup(k, seed + k, placed.body, placed.yaw)
 
 
 def episode_setups(params: GraspParams, seed: int, episodes: int) -> list[EpisodeSetup]:

@@ -17,6 +17,7 @@ import numpy as np
 
 from robocfg.config.commands import Limits, PickPlaceParams
 from robocfg.engine.options import FrameRecorder, RunOptions, option
+from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
@@ -36,23 +37,17 @@ PickPlaceTiming = BatchTiming
 
 
 def episode_setup(params: PickPlaceParams, seed: int, k: int) -> EpisodeSetup:
-    """Episode ``k``'s randomised object and place point, a fixed function of (seed, k)."""
-    obj = params.object
+    """Episode ``k``'s randomised object (pose, mass, friction) and place point, a fixed function
+    of (seed, k): the object is placed first, then the place point, mass and friction are drawn."""
     rz = params.randomize
-    base_yaw = math.radians((obj.euler_deg or [0, 0, 0])[2])
     rng = episode_rng(seed, k)
-    dx, dy = (rng.uniform(-1, 1, 2) * np.asarray(rz.object.xy_range))
-    dyaw = math.radians(rng.uniform(-1, 1) * rz.object.yaw_range_deg)
+    placed = place_randomly(params.object, rz.object, rng)
     px, py = (rng.uniform(-1, 1, 2) * np.asarray(rz.place.xy_range))
+    obj = params.object
     mass = obj.mass * (1 + rng.uniform(-1, 1) * rz.mass_scale)
     friction = obj.friction * (1 + rng.uniform(-1, 1) * rz.friction_scale)
-    yaw = base_yaw + dyaw
-    roll, pitch = (obj.euler_deg or [0, 0, 0])[:2]
-    body = obj.model_copy(update={
-        "position": [obj.position[0] + dx, obj.position[1] + dy, obj.position[2]],
-        "euler_deg": [roll, pitch, math.degrees(yaw)], "quat_xyzw": None, "quat_wxyz": None,
-        "mass": mass, "friction": friction,
-    })
+    body = placed.body.model_copy(update={"mass": mass, "friction": friction})
+    yaw = math.radians((obj.euler_deg or [0, 0, 0])[2]) + placed.yaw
     place = np.asarray(params.place_position[:2]) + np.array([px, py])
     return EpisodeSetup(k, seed + k, body, yaw, place)
 
