@@ -133,4 +133,3 @@ def test_one_phase_failed_error_for_moves_episodes_and_runs():
     exc = PhysicsDiverged(1.25, "body 'cube' speed 90 m/s")
     assert isinstance(exc, RunFailed) and isinstance(exc, PhaseFailed)
     assert (exc.phase, exc.reason) == ("physics", "physics diverged at t = 1.250 s (body 'cube' speed 90 m/s)")
-
