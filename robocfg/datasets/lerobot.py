@@ -13,15 +13,15 @@ which a robocfg run reaches only at tens of thousands of episodes)::
 
 Timestamps are ``frame_index / fps``; an episode's video frames start at its
 ``videos/<key>/from_timestamp``. Videos: H.264 (libx264), yuv420p, a keyframe every 2 frames
-(LeRobot's own choice, for exact random access).
+(LeRobot's own choice, for exact random access), each episode encoded on its own and the
+episodes' packets joined (:mod:`robocfg.datasets.video`), so shards written by several workers
+merge into the very bytes one process would write (:mod:`robocfg.datasets.shards`).
 """
 
 from __future__ import annotations
 
 import json
-from fractions import Fraction
 from pathlib import Path
-from typing import Any, cast
 
 import numpy as np
 import pyarrow as pa
@@ -29,13 +29,13 @@ import pyarrow.parquet as pq
 
 from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
 from robocfg.datasets.stats import ImageStats, vector_stats
+from robocfg.datasets.video import EncodedVideo, VideoConcat, encode_episode
 from robocfg.errors import RobocfgError
 
 CODEBASE_VERSION = "v3.0"
 DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
 EPISODES_PATH = "meta/episodes/chunk-000/file-000.parquet"
-VIDEO_CODEC = "libx264"
 STATE, ENV, ACTION = "observation.state", "observation.environment_state", "action"
 
 
@@ -57,12 +57,20 @@ class LeRobotWriter:
         self.episodes: list[dict] = []
         self.tasks: dict[str, int] = {}
         self.frames = 0
-        self.videos = {c.name: _VideoFile(self.root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
-                                                                        file_index=0), c.width, c.height, layout.fps)
+        self.videos = {c.name: VideoConcat(self.root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
+                                                                         file_index=0), layout.fps)
                        for c in layout.cameras}
         self.image_stats = {c.name: ImageStats() for c in layout.cameras}
 
     def add(self, ep: EpisodeRecord) -> None:
+        """Append an episode with its raw images (encoded here, one segment per camera)."""
+        for name in self.videos:
+            self.image_stats[name].add(ep.images[name])
+        self.add_encoded(ep, {name: encode_episode(ep.images[name], self.layout.fps) for name in self.videos})
+
+    def add_encoded(self, ep: EpisodeRecord, videos: dict[str, EncodedVideo]) -> None:
+        """Append an episode whose camera frames are already encoded (``ep.images`` is not read;
+        their statistics come separately, :meth:`add_image_histograms`)."""
         n, k = ep.length, len(self.episodes)
         task_index = self.tasks.setdefault(ep.language, len(self.tasks))
         for key, arr in ((STATE, ep.state), (ENV, ep.env_state), (ACTION, ep.action), ("phase_index", ep.phase)):
@@ -76,8 +84,7 @@ class LeRobotWriter:
         for name, video in self.videos.items():
             key = image_key(name)
             t0 = video.frames / self.layout.fps
-            video.write(ep.images[name])
-            self.image_stats[name].add(ep.images[name])
+            video.append(videos[name])
             row |= {f"videos/{key}/chunk_index": 0, f"videos/{key}/file_index": 0,
                     f"videos/{key}/from_timestamp": t0, f"videos/{key}/to_timestamp": t0 + n / self.layout.fps}
         row |= {"meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0,
@@ -85,6 +92,13 @@ class LeRobotWriter:
                 "run_episode": ep.index, "physics_steps": ep.physics_steps, "object_final": ep.object_final}
         self.episodes.append(row)
         self.frames += n
+
+    def add_image_histograms(self, stats: dict[str, ImageStats]) -> None:
+        """Add the colour histograms of episodes given by :meth:`add_encoded` (integer counts, so
+        the sum is the same in any order)."""
+        for name, s in stats.items():
+            self.image_stats[name].hist += s.hist
+            self.image_stats[name].frames += s.frames
 
     def close(self) -> Path:
         """Write the parquet files and metadata; returns the dataset root."""
@@ -141,34 +155,6 @@ class LeRobotWriter:
             "video_path": VIDEO_PATH if lay.cameras else None, "features": features,
             "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, **self.extra_info},
         }
-
-
-class _VideoFile:
-    """One MP4 that frames are appended to, frame i at pts i (time base 1/fps)."""
-
-    def __init__(self, path: Path, width: int, height: int, fps: int):
-        import av
-
-        path.parent.mkdir(parents=True, exist_ok=True)
-        self.container = av.open(str(path), "w")
-        self.stream: Any = cast(Any, self.container.add_stream(
-            VIDEO_CODEC, rate=fps, options={"g": "2", "crf": "23", "preset": "veryfast"}))
-        self.stream.width, self.stream.height, self.stream.pix_fmt = width, height, "yuv420p"
-        self.stream.time_base = Fraction(1, fps)
-        self.frames = 0
-
-    def write(self, frames: np.ndarray) -> None:
-        import av
-
-        for rgb in frames:
-            f = av.VideoFrame.from_ndarray(rgb, format="rgb24")
-            f.pts = self.frames
-            self.frames += 1
-            self.container.mux(self.stream.encode(f))
-
-    def close(self) -> None:
-        self.container.mux(self.stream.encode(None))
-        self.container.close()
 
 
 def _fixed_list(x: np.ndarray, d: int) -> pa.Array:

@@ -1,0 +1,166 @@
+"""Dataset shards: what one worker of a parallel run writes, and their merge into one dataset.
+
+A shard is an ordinary dataset (LeRobot v3.0 directory or robomimic HDF5 file) holding the kept
+episodes of one batch of a run, written by the same writer as a single-process run. The merge
+reads every shard back and hands the episodes, ordered by their episode index in the run, to a
+fresh writer: data rows, episode metadata and task indices are renumbered, statistics are
+recomputed over all frames (image statistics summed from the shards' exact colour histograms),
+and LeRobot videos are joined by copying each episode's packets. The merged dataset is therefore
+the same, file for file, as the one a single process writes for the same task and seed, however
+the episodes were spread over workers.
+"""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
+from robocfg.datasets.sink import DatasetSink, DatasetSummary, Format, make_writer
+from robocfg.datasets.stats import ImageStats
+
+
+@dataclass(frozen=True)
+class Shard:
+    """One closed shard: where it is, its format, the layout of its episodes (None when no episode
+    was run into it), episodes run and kept, frames, and its cameras' colour histograms
+    (camera → (3, 256) counts, with the number of frames they cover)."""
+
+    path: str
+    fmt: Format
+    layout: DatasetLayout | None
+    episodes_run: int
+    episodes_kept: int
+    frames: int
+    image_hist: dict[str, np.ndarray] = field(default_factory=dict)
+    image_frames: dict[str, int] = field(default_factory=dict)
+
+
+def close_shard(sink: DatasetSink) -> Shard:
+    """Close ``sink`` (a sink writing into a shard folder) and describe what it holds."""
+    sink.close()
+    hist: dict[str, np.ndarray] = {}
+    frames: dict[str, int] = {}
+    stats = getattr(sink.writer, "image_stats", None) or {}
+    for name, s in stats.items():
+        hist[name], frames[name] = s.hist.copy(), s.frames
+    return Shard(str(sink.root), sink.fmt, sink.layout, sink.run, sink.kept, sink.frames, hist, frames)
+
+
+def merge_shards(shards: list[Shard], out: Path, fmt: Format, extra_info: dict,
+                 remove: bool = True) -> DatasetSummary:
+    """Write the episodes of ``shards`` into the dataset ``out`` ordered by their episode index
+    in the run; ``remove`` deletes the shard folders afterwards."""
+    out = Path(out)
+    layouts = [s.layout for s in shards if s.layout is not None]
+    run = sum(s.episodes_run for s in shards)
+    if not layouts:  # no episode ran (every worker lost): an empty dataset is still no dataset
+        return DatasetSummary(str(out), fmt, 0, run, 0)
+    layout = layouts[0]
+    writer = make_writer(fmt, out, layout, extra_info)
+    episodes = []
+    for s in shards:
+        if s.episodes_kept:
+            episodes += _read_lerobot(s, layout) if fmt == "lerobot" else _read_hdf5(s, layout)
+    episodes.sort(key=lambda e: e[0].index)
+    frames = 0
+    for ep, videos in episodes:
+        if fmt == "lerobot":
+            writer.add_encoded(ep, videos)
+        else:
+            writer.add(ep)
+        frames += ep.length
+    if fmt == "lerobot":
+        writer.add_image_histograms(_summed_histograms(shards))
+    writer.close()
+    if remove:
+        for s in shards:
+            shutil.rmtree(s.path, ignore_errors=True)
+    return DatasetSummary(str(out), fmt, len(episodes), run, frames)
+
+
+def _summed_histograms(shards: list[Shard]) -> dict[str, ImageStats]:
+    total: dict[str, ImageStats] = {}
+    for s in shards:
+        for name, hist in s.image_hist.items():
+            st = total.setdefault(name, ImageStats())
+            st.hist += hist
+            st.frames += s.image_frames[name]
+    return total
+
+
+def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeRecord, dict]]:
+    import pyarrow.parquet as pq
+
+    from robocfg.datasets.lerobot import (
+        ACTION,
+        DATA_PATH,
+        ENV,
+        EPISODES_PATH,
+        STATE,
+        VIDEO_PATH,
+        image_key,
+    )
+    from robocfg.datasets.video import split_segments
+
+    root = Path(shard.path)
+    rows = pq.read_table(root / EPISODES_PATH).to_pylist()
+    data = pq.read_table(root / DATA_PATH.format(chunk_index=0, file_index=0))
+    cols = {k: np.asarray(data[k].combine_chunks().flatten().to_numpy(zero_copy_only=False))
+            for k in (STATE, ENV, ACTION)}
+    dims = {STATE: len(layout.state_names), ENV: len(layout.env_state_names), ACTION: len(layout.action_names)}
+    vec = {k: cols[k].astype(np.float32).reshape(-1, d) for k, d in dims.items()}
+    phase = data["phase_index"].to_numpy().astype(np.int64)
+    lengths = [r["length"] for r in rows]
+    segments = {c.name: split_segments(root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
+                                                                  file_index=0), layout.fps, lengths)
+                for c in layout.cameras}
+    out = []
+    for i, r in enumerate(rows):
+        a, b = r["dataset_from_index"], r["dataset_to_index"]
+        ep = EpisodeRecord(index=r["run_episode"], seed=r["seed"], language=r["tasks"][0], success=r["success"],
+                           failed_phase=r["failed_phase"], reason=r["reason"], physics_steps=r["physics_steps"],
+                           object_final=list(r["object_final"]), state=vec[STATE][a:b], env_state=vec[ENV][a:b],
+                           action=vec[ACTION][a:b], phase=phase[a:b])
+        out.append((ep, {name: segs[i] for name, segs in segments.items()}))
+    return out
+
+
+def _read_hdf5(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeRecord, dict]]:
+    import h5py
+
+    from robocfg.datasets.hdf5 import FILE_NAME
+
+    out = []
+    with h5py.File(Path(shard.path) / FILE_NAME, "r") as f:
+        for name in sorted(f["data"].keys(), key=lambda n: int(n.split("_")[1])):
+            g = f["data"][name]
+            a = g.attrs
+            obs = g["obs"]
+            ep = EpisodeRecord(
+                index=int(a["run_episode"]), seed=int(a["seed"]), language=str(a["language"]),
+                success=bool(a["success"]), failed_phase=str(a["failed_phase"]) or None, reason=str(a["reason"]),
+                physics_steps=int(a["physics_steps"]), object_final=[float(v) for v in a["object_final"]],
+                state=obs["robot_state"][()], env_state=obs["object_state"][()], action=g["actions"][()],
+                phase=g["phase"][()],
+                images={c.name: obs[f"{c.name}_image"][()] for c in layout.cameras},
+                depth={c.name: obs[f"{c.name}_depth"][()] for c in layout.cameras if c.depth})
+            out.append((ep, {}))
+    return out
+
+
+class MergedShards:
+    """The dataset sink of a distributed run's driver: the workers recorded into ``shards``;
+    ``close()`` merges them into ``root`` (and removes ``root/.shards``), like a single-process
+    sink's ``close()`` writes its dataset."""
+
+    def __init__(self, shards: list[Shard], root: Path, fmt: Format, extra_info: dict):
+        self.shards, self.root, self.fmt, self.extra_info = shards, Path(root), fmt, extra_info
+
+    def close(self) -> DatasetSummary:
+        summary = merge_shards(self.shards, self.root, self.fmt, self.extra_info)
+        shutil.rmtree(self.root / ".shards", ignore_errors=True)
+        return summary
