@@ -165,6 +165,7 @@ class ArmMover:
         dt = self.world.dt
         n = math.ceil(traj.duration / dt - 1e-9)
         q_ref, qd_ref, _ = traj.evaluate(np.arange(1, n + 1) * dt)
+        q_ref, qd_ref = q_ref.tolist(), qd_ref.tolist()  # once, not per step
         for k in range(n):
             self.arm.command(q_ref[k], qd_ref[k])
             self.step(1)

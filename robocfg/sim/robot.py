@@ -164,8 +164,12 @@ class RobotHandle:
                 self._drive_list(key), [self.joint_index[n] for n in key], [d.position_gain for d in drives],
                 [d.velocity_gain for d in drives], [d.force for d in drives], drives)
         _, idx, kp, kd, force, drives = plan
-        targets = np.asarray(q, dtype=float).tolist()
-        speeds = [0.0] * len(idx) if velocities is None else np.asarray(velocities, dtype=float).tolist()
+        # lists (a trajectory converted once) are sent as they are: no per-step array round trip
+        targets = q if type(q) is list else np.asarray(q, dtype=float).tolist()
+        if velocities is None:
+            speeds = [0.0] * len(idx)
+        else:
+            speeds = velocities if type(velocities) is list else np.asarray(velocities, dtype=float).tolist()
         if len(targets) != len(idx) or len(speeds) != len(idx):
             return False
         for d, v, w in zip(drives, targets, speeds):  # noqa: B905 - lengths checked above
