@@ -23,6 +23,7 @@ from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, S
 from robocfg.cli.completion import task_names
 from robocfg.cli.record_opts import CameraOpt, FpsOpt, SizeOpt, record_settings
 from robocfg.cli.set_option import SetOpt
+from robocfg.cli.executor_opts import ExecutorOpt, RayAddressOpt, WorkersOpt
 
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
@@ -65,6 +66,9 @@ def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Param
         opt("min_success", Annotated[float, typer.Option("--min-success", min=0.0, max=1.0,
                                                          help=f"Exit 1 when the share of episodes {verb} is below this.")], 1.0),
         opt("set_", SetOpt, None),
+        opt("workers", WorkersOpt, None),
+        opt("executor", ExecutorOpt, "local"),
+        opt("ray_address", RayAddressOpt, None),
     ]
 
 
@@ -138,7 +142,8 @@ def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
 def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm: str | None, seed: int | None,
             episodes: int, json_path: Path | None, record: Path | None, record_episode: int, gui: bool,
             quiet: bool, min_success: float, extras: Any, set_: list[str] | None = None, camera: str | None = None,
-            size: str | None = None, fps: float | None = None) -> int:
+            size: str | None = None, fps: float | None = None, workers: int | None = None, executor: str = "local",
+            ray_address: str | None = None) -> int:
     """Check, run, write and print one ``run <kind>``; the exit code (0, 1 or 130)."""
     from robocfg.cli.common import console, load_task_for, write_json
     from robocfg.cli.episodes import (
@@ -147,6 +152,7 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
         progress_bar,
         stop_on_signals,
     )
+    from robocfg.cli.executor_opts import resolve_workers
     from robocfg.cli.run_print import print_report
     from robocfg.cli.set_option import overrides
     from robocfg.engine.options import RunOptions
@@ -158,6 +164,8 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     kind = runner_type.kind
     check_record_episode(record_episode, episodes, record is not None)
     recording = record_settings(camera, size, fps, record is not None)
+    n_workers = resolve_workers(workers, episodes, executor, gui)
+    distributed = runner_type.episodic and (n_workers > 1 or executor == "ray")
     quiet_import()
     checked = load_task_for(task, kind, command_name(kind), robot, overrides(set_))
     out = console()
@@ -170,23 +178,34 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     if hook is not None:
         runner.options = hook.prepare(checked, runner.options, robot)
     failed: RunFailed | None = None
+    lost: list[Any] = []
     with stop_on_signals() as stop, \
             progress_bar(command_name(kind), episodes, runner_type.verb, episodes > 1 and not quiet) as tick:
         runner.options = dataclasses.replace(runner.options, on_episode=tick, should_stop=stop)
         try:
-            output = runner.run()
+            if distributed:
+                from robocfg.cli.parallel import run_distributed
+
+                output, runner.options, lost = run_distributed(checked, runner.options, n_workers, executor,
+                                                               ray_address)
+            else:
+                output = runner.run()
         except RunFailed as exc:
             if exc.report is None:
                 raise
             failed, output = exc, RunOutput(exc.report)
     extra_lines = hook.finish(runner.options, output.report) if hook is not None else []
-    write_json(json_path, output.report)
+    from robocfg.cli.parallel import lost_lines, with_lost
+
+    write_json(json_path, with_lost(output.report, lost))
     print_report(output.report, output.timing, quiet, record, extra_lines)
+    for line in lost_lines(lost):
+        console(stderr=True).print(line, markup=False)
     if output.report.interrupted:
         console(stderr=True).print(interrupted_line(stop, output.report.episodes_finished(), episodes, json_path),
                                    markup=False)
         return 130
-    if failed is not None:
+    if failed is not None or lost:
         return 1
     return 0 if output.report.passed(min_success) else 1
 

@@ -1,0 +1,189 @@
+"""``--workers N``: episodes spread over N local processes, each building its world once.
+
+The driver hands out one batch at a time to each worker over a pipe and waits on the pipes and
+on the processes' sentinels together (``multiprocessing.connection.wait``), so a worker that dies
+— killed, segfaulted, out of memory — is seen at once: its unfinished batch is reported lost
+with the way it died, its remaining work goes to the others, and the run never hangs. Workers
+come from a fork server that has imported the recipe's modules once (no threads in it, so
+forking is safe even when the driver runs Ray or a progress-bar thread), and ignore SIGINT: the
+driver decides, on the first Ctrl-C, to hand out nothing more and collect what is running.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing as mp
+import signal
+import traceback
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from multiprocessing.connection import Connection, wait
+from typing import Any
+
+from robocfg.errors import RobocfgError
+from robocfg.executors.outcome import Execution, LostEpisodes
+from robocfg.executors.session import (
+    Batch,
+    BatchDone,
+    EpisodeRun,
+    Recipe,
+    ReportRequest,
+    report_in_driver,
+    run_batch,
+)
+
+POLL = 0.5  # s: how often the driver looks at the stop request while waiting
+JOIN_TIMEOUT = 10.0  # s a finished worker gets to exit before it is terminated
+
+
+class WorkerError(RobocfgError):
+    """A worker raised (not a failed episode: those are records) — e.g. the world cannot be built."""
+
+
+def _worker_main(conn: Connection, recipe: Recipe) -> None:
+    """A worker: open the recipe once, then run the batches it is sent (and make the report when
+    asked) until it is sent None."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        session = recipe.open()
+        try:
+            while (msg := conn.recv()) is not None:
+                if isinstance(msg, ReportRequest):
+                    conn.send(("report", session.report(msg.records, msg.interrupted)))
+                    continue
+                done = run_batch(session, recipe.dataset, msg, lambda run: conn.send(("episode", run)))
+                conn.send(("done", done))
+        finally:
+            session.close()
+    except BaseException as exc:  # reported to the driver, which raises it there
+        conn.send(("error", f"{type(exc).__name__}: {exc}", traceback.format_exc()))
+    finally:
+        conn.close()
+
+
+@dataclass
+class _Worker:
+    process: Any
+    conn: Connection
+    batch: Batch | None = None
+    finished: int = 0  # episodes of the current batch reported so far
+
+
+class ProcessPool:
+    """Run a recipe's episodes on ``workers`` local processes (see the module docstring)."""
+
+    def __init__(self, workers: int):
+        if workers < 1:
+            raise RobocfgError(f"--workers {workers}: need at least 1")
+        self.workers = workers
+        self.pids: list[int] = []  # the worker processes' ids, once started
+
+    def run(self, recipe: Recipe, batches: list[Batch], on_episode: Callable[[EpisodeRun], None] | None = None,
+            should_stop: Callable[[], bool] | None = None) -> Execution:
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["robocfg.executors.boot", "robocfg.executors.pool", *recipe.preload])
+        todo = deque(batches)
+        result = Execution(workers=min(self.workers, len(batches)) or 1)
+        pool: list[_Worker] = []
+        try:
+            for _ in range(result.workers):
+                parent, child = ctx.Pipe()
+                proc = ctx.Process(target=_worker_main, args=(child, recipe), daemon=True)
+                proc.start()
+                child.close()
+                pool.append(_Worker(proc, parent))
+            self.pids = [w.process.pid for w in pool]
+            for w in pool:
+                self._hand_out(w, todo)
+            while any(w.batch is not None for w in pool):
+                if should_stop is not None and should_stop() and todo:
+                    result.interrupted = True
+                    todo.clear()
+                busy = [w for w in pool if w.batch is not None]
+                ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy], timeout=POLL)
+                for w in busy:
+                    if w.conn in ready or w.process.sentinel in ready:
+                        self._serve(w, todo, result, on_episode)
+            for lost in todo:  # only when every worker died
+                result.lost.append(LostEpisodes(lost.indices, "no worker left to run it"))
+            result.report = self._report(pool, recipe, result)
+        finally:
+            for w in pool:
+                self._stop(w)
+        return result
+
+    @staticmethod
+    def _report(pool: list[_Worker], recipe: Recipe, result: Execution) -> Any:
+        """The run's report, made by the first worker still alive (its session has the world the
+        report may need); with none left, by a session opened here."""
+        request = ReportRequest(result.records, result.interrupted)
+        for w in pool:
+            if not w.process.is_alive():
+                continue
+            try:
+                w.conn.send(request)
+                ready = wait([w.conn, w.process.sentinel])
+                if w.conn in ready and w.conn.poll():
+                    msg = w.conn.recv()
+                    if msg[0] == "report":
+                        return msg[1]
+                    if msg[0] == "error":
+                        raise WorkerError(f"worker {w.process.pid} failed: {msg[1]}\n{msg[2]}")
+            except (EOFError, OSError):
+                continue
+        return report_in_driver(recipe, request.records, request.interrupted)
+
+    def _hand_out(self, w: _Worker, todo: deque[Batch]) -> None:
+        w.batch, w.finished = (todo.popleft() if todo else None), 0
+        if w.batch is None:  # idle until the report is asked for or the pool stops
+            return
+        if w.process.is_alive():
+            with contextlib.suppress(OSError):  # died meanwhile: its sentinel tells the rest
+                w.conn.send(w.batch)
+
+    def _serve(self, w: _Worker, todo: deque[Batch], result: Execution,
+               on_episode: Callable[[EpisodeRun], None] | None) -> None:
+        """Read what worker ``w`` sent; if it is gone, account for its batch."""
+        while w.batch is not None:
+            try:
+                if not w.conn.poll():
+                    break
+                msg = w.conn.recv()
+            except (EOFError, OSError):
+                break
+            if msg[0] == "episode":
+                w.finished += 1
+                if on_episode is not None:
+                    on_episode(msg[1])
+            elif msg[0] == "done":
+                done: BatchDone = msg[1]
+                result.done.append(done)
+                self._hand_out(w, todo)
+            else:
+                raise WorkerError(f"worker {w.process.pid} failed: {msg[1]}\n{msg[2]}")
+        if w.batch is not None and not w.process.is_alive():
+            w.process.join()
+            result.lost.append(LostEpisodes(w.batch.indices, _death(w.process.pid, w.process.exitcode)))
+            w.batch = None
+
+    @staticmethod
+    def _stop(w: _Worker) -> None:
+        if w.process.is_alive():
+            with contextlib.suppress(OSError):
+                w.conn.send(None)
+            w.process.join(JOIN_TIMEOUT)
+            if w.process.is_alive():
+                w.process.terminate()
+                w.process.join()
+        w.conn.close()
+
+
+def _death(pid: int, code: int | None) -> str:
+    if code is not None and code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = f"signal {-code}"
+        return f"worker {pid} killed by {name}"
+    return f"worker {pid} exited with status {code}"

@@ -1,0 +1,132 @@
+"""``--executor ray``: the same batches as ``--workers``, run by Ray actors (one CPU each).
+
+Each actor opens the recipe once (its world lives as long as the actor) and runs the batches it
+is given as actor calls; the driver keeps one call in flight per actor and hands the next batch
+to whichever actor returns first. Dataset shards are written by the actors under the dataset
+folder, so on a cluster that folder must be on a filesystem every node shares (see
+``docs/scale-out.md``); the driver merges them. An actor that dies (node lost, process killed)
+surfaces as ``RayActorError`` on its call: that batch is reported lost and the others go on.
+
+Where Ray runs: ``address`` (``--ray-address``), else ``RAY_ADDRESS``, else a local Ray started
+here and shut down after the run. A Ray already initialised in this process (a test, a notebook)
+is used as it is.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+from robocfg.errors import RobocfgError
+from robocfg.executors.outcome import Execution, LostEpisodes
+from robocfg.executors.pool import POLL, WorkerError
+from robocfg.executors.session import (
+    Batch,
+    BatchDone,
+    EpisodeRun,
+    Recipe,
+    report_in_driver,
+    run_batch,
+)
+
+
+class _Actor:
+    """A Ray actor holding one session."""
+
+    def __init__(self, recipe: Recipe):
+        self.recipe = recipe
+        self.session = recipe.open()
+
+    def pid(self) -> int:
+        return os.getpid()
+
+    def run(self, batch: Batch) -> BatchDone:
+        return run_batch(self.session, self.recipe.dataset, batch)
+
+    def report(self, records: list[Any], interrupted: bool) -> Any:
+        return self.session.report(records, interrupted)
+
+
+class RayPool:
+    """Run a recipe's episodes on ``workers`` Ray actors (see the module docstring)."""
+
+    def __init__(self, workers: int, address: str | None = None):
+        if workers < 1:
+            raise RobocfgError(f"--workers {workers}: need at least 1")
+        self.workers, self.address = workers, address
+        self.actors: list[Any] = []
+
+    def run(self, recipe: Recipe, batches: list[Batch], on_episode: Callable[[EpisodeRun], None] | None = None,
+            should_stop: Callable[[], bool] | None = None) -> Execution:
+        try:
+            import ray
+            from ray.exceptions import RayActorError, RayTaskError
+        except ImportError as exc:
+            raise RobocfgError("--executor ray needs Ray: pip install 'robocfg[ray]'") from exc
+        started = False
+        if not ray.is_initialized():
+            address = self.address or os.environ.get("RAY_ADDRESS") or None
+            ray.init(address=address, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False)
+            started = True
+        result = Execution(workers=min(self.workers, len(batches)) or 1)
+        todo = deque(batches)
+        remote = ray.remote(num_cpus=1, max_restarts=0)(_Actor)
+        self.actors = [remote.remote(recipe) for _ in range(result.workers)]
+        inflight: dict[Any, tuple[Any, Batch]] = {}
+
+        def hand_out(actor: Any) -> None:
+            if todo:
+                batch = todo.popleft()
+                inflight[actor.run.remote(batch)] = (actor, batch)
+
+        try:
+            for a in self.actors:
+                hand_out(a)
+            while inflight:
+                if should_stop is not None and should_stop() and todo:
+                    result.interrupted = True
+                    todo.clear()
+                ready, _ = ray.wait(list(inflight), num_returns=1, timeout=POLL)
+                for ref in ready:
+                    actor, batch = inflight.pop(ref)
+                    try:
+                        done: BatchDone = ray.get(ref)
+                    except RayActorError as exc:
+                        result.lost.append(LostEpisodes(batch.indices, f"Ray actor died: {_first_line(exc)}"))
+                        continue
+                    except RayTaskError as exc:
+                        raise WorkerError(f"a Ray worker failed: {_first_line(exc)}") from exc
+                    result.done.append(done)
+                    if on_episode is not None:
+                        for run in done.runs:
+                            on_episode(run)
+                    hand_out(actor)
+            for batch in todo:
+                result.lost.append(LostEpisodes(batch.indices, "no Ray actor left to run it"))
+            result.report = _report_of(ray, self.actors, recipe, result)
+        finally:
+            for a in self.actors:
+                ray.kill(a)
+            if started:
+                ray.shutdown()
+        return result
+
+
+def _report_of(ray: Any, actors: list[Any], recipe: Recipe, result: Execution) -> Any:
+    """The run's report from the first actor that answers; with none left, from a session here."""
+    from ray.exceptions import RayActorError
+
+    for a in actors:
+        try:
+            return ray.get(a.report.remote(result.records, result.interrupted))
+        except RayActorError:
+            continue
+    return report_in_driver(recipe, result.records, result.interrupted)
+
+
+def _first_line(exc: BaseException) -> str:
+    lines = [ln for ln in str(exc).splitlines() if ln.strip()]
+    return lines[0] if lines else type(exc).__name__

@@ -1,0 +1,159 @@
+"""What an executor distributes, and what runs in each worker.
+
+An executor never simulates. It receives a *recipe* (picklable: the task's source and the run
+options, no world, no open file) and episode indices. Each worker process opens the recipe once
+into a *session* (builds the world, kinematics and controllers once), then runs the episodes
+it is given with ``session.run(k, sink)``. Episode k draws its randomness from
+``numpy.random.default_rng([seed, k])``, so its record is the same in whichever worker, in
+whichever order, it runs. Episodes are handed out in *batches*; a batch is the unit that is
+committed: its records come back together with the dataset shard its episodes were written to,
+and a worker that dies takes exactly its unfinished batch with it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
+if TYPE_CHECKING:
+    from robocfg.datasets.shards import Shard
+    from robocfg.datasets.sink import DatasetSink, Format, Keep
+
+
+class EpisodeRecord(Protocol):
+    """The fields of an episode's record the executors read (the progress bar counts successes)."""
+
+    index: int
+    success: bool
+
+
+class Session(Protocol):
+    """A worker's built world for one task: runs episode ``k`` (recording into ``sink`` when one
+    is given) and returns its :class:`EpisodeRun`; ``report`` makes the run's report from the
+    records of every finished episode (in index order). ``task``: the checked task."""
+
+    task: Any
+
+    def run(self, k: int, sink: DatasetSink | None = None) -> EpisodeRun: ...
+
+    def report(self, records: list[Any], interrupted: bool) -> Any: ...
+
+    def close(self) -> None: ...
+
+
+class Recipe(Protocol):
+    """Picklable description of a run that a worker opens into a :class:`Session`.
+
+    ``preload``: modules a worker imports before it is handed anything (a process pool imports them
+    once in its fork server, so each worker starts without paying the imports again)."""
+
+    @property
+    def episodes(self) -> int: ...
+
+    @property
+    def dataset(self) -> DatasetTarget | None: ...
+
+    @property
+    def preload(self) -> tuple[str, ...]: ...
+
+    def open(self) -> Session: ...
+
+
+@dataclass(frozen=True)
+class EpisodeRun:
+    """One finished episode: its record (the report's entry), wall time (s) and the part of it spent
+    stepping the physics (s)."""
+
+    record: Any
+    wall: float
+    physics: float
+
+    @property
+    def index(self) -> int:
+        return int(self.record.index)
+
+    @property
+    def success(self) -> bool:
+        return bool(self.record.success)
+
+
+@dataclass(frozen=True)
+class DatasetTarget:
+    """Where and how a run's episodes are recorded: the dataset folder, format, frame rate (Hz), which episodes are kept, the language string and the run facts stored in the
+    dataset's metadata. Workers write shards under ``<root>/.shards/``; the driver merges them
+    into ``root``."""
+
+    root: Path
+    fmt: Format
+    fps: int
+    keep: Keep
+    language: str
+    extra_info: dict = field(default_factory=dict)
+
+    def shard_root(self, batch: int) -> Path:
+        return Path(self.root) / ".shards" / f"batch-{batch:05d}"
+
+    def sink(self, task: Any, root: Path) -> DatasetSink:
+        from robocfg.datasets.sink import DatasetSink
+
+        return DatasetSink(root, self.fmt, task, fps=self.fps, keep=self.keep, language=self.language,
+                           extra_info=dict(self.extra_info))
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Episode indices run one after the other by one worker; ``id`` numbers its shard."""
+
+    id: int
+    indices: tuple[int, ...]
+
+
+@dataclass
+class BatchDone:
+    """A committed batch: its episodes' runs in index order and the shard they were recorded to."""
+
+    batch: Batch
+    runs: list[EpisodeRun]
+    shard: Shard | None
+
+
+@dataclass(frozen=True)
+class ReportRequest:
+    """Sent to one worker at the end: make the run's report from these records (index order)."""
+
+    records: list[Any]
+    interrupted: bool
+
+
+def plan_batches(episodes: int, workers: int, recording: bool) -> list[Batch]:
+    """Consecutive index ranges. Without a dataset a batch is one episode (a crash loses one);
+    with one, up to 8 episodes share a shard (fewer files to merge), keeping at least 4 batches
+    per worker so the workers finish together."""
+    size = 1 if not recording else max(1, min(8, episodes // (4 * max(1, workers))))
+    return [Batch(i, tuple(range(a, min(a + size, episodes)))) for i, a in enumerate(range(0, episodes, size))]
+
+
+def run_batch(session: Session, dataset: DatasetTarget | None, batch: Batch,
+              on_episode: Callable[[EpisodeRun], None] | None = None) -> BatchDone:
+    """Run ``batch`` in ``session``; with a dataset, record it into the batch's shard and close it."""
+    from robocfg.datasets.shards import close_shard
+
+    sink = dataset.sink(session.task, dataset.shard_root(batch.id)) if dataset is not None else None
+    runs = []
+    for k in batch.indices:
+        run = session.run(k, sink)
+        runs.append(run)
+        if on_episode is not None:
+            on_episode(run)
+    return BatchDone(batch, runs, close_shard(sink) if sink is not None else None)
+
+
+def report_in_driver(recipe: Recipe, records: list[Any], interrupted: bool) -> Any:
+    """The run's report from a session opened here: when no worker is left to make it."""
+    session = recipe.open()
+    try:
+        return session.report(records, interrupted)
+    finally:
+        session.close()
