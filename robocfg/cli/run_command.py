@@ -21,9 +21,9 @@ import typer
 
 from robocfg.cli.common import GuiOpt, JsonOpt, QuietOpt, RecordOpt, RobotOpt, SeedOpt, _output_path
 from robocfg.cli.completion import task_names
+from robocfg.cli.executor_opts import ExecutorOpt, RayAddressOpt, WorkersOpt
 from robocfg.cli.record_opts import CameraOpt, FpsOpt, SizeOpt, record_settings
 from robocfg.cli.set_option import SetOpt
-from robocfg.cli.executor_opts import ExecutorOpt, RayAddressOpt, WorkersOpt
 
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
