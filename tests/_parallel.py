@@ -12,7 +12,7 @@ from _cli import ROOT, run_main
 
 def small_camera_task(tmp: Path) -> Path:
     """The shipped pick-place task with 32x32 cameras."""
-    doc = yaml.safe_load((ROOT / "tasks/pick_place.yaml").read_text())
+    doc = yaml.safe_load((ROOT / "robocfg/data/tasks/pick_place.yaml").read_text())
     for cam in doc["cameras"]:
         cam["width"] = cam["height"] = 32
     path = tmp / "pick_place_small_cams.yaml"

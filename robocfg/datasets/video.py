@@ -24,7 +24,11 @@ from typing import Any, cast
 import numpy as np
 
 VIDEO_CODEC = "libx264"
-ENCODER_OPTIONS = {"g": "2", "crf": "23", "preset": "veryfast", "bframes": "0", "threads": "1"}
+# rc-lookahead=0 (which also turns macroblock-tree rate control off): with lookahead, x264 gave
+# the same frames a different bitstream now and then within one process (it depended on what the
+# process had done before); without it the bytes are a function of the frames alone.
+ENCODER_OPTIONS = {"g": "2", "crf": "23", "preset": "veryfast", "bframes": "0", "threads": "1",
+                   "x264-params": "rc-lookahead=0"}
 
 
 @dataclass(frozen=True)
