@@ -132,8 +132,8 @@ class EpisodeSession(ABC, Generic[RecordT]):
         recorder = self._recorder(k)
         record = self.episode(k, recorder)
         if recorder is not None:
-            ok = bool(getattr(record, "success", False))  # the outcome banner of the last frame
-            recorder.finish(ok, "" if ok else f"{getattr(record, 'failed_phase', '')}: {getattr(record, 'reason', '')}")
+            ok = record.success  # the outcome banner of the last frame
+            recorder.finish(ok, "" if ok else f"{record.failed_phase}: {record.reason}")
             recorder.save()
         self.timing.per_episode.append(time.perf_counter() - t0)
         self.timing.physics_per_episode.append(w.physics_seconds - physics0)

@@ -104,8 +104,6 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         except MoveFailed as exc:
             failed, reason = exc.phase, exc.reason
             sm.close_phase(False, reason)
-        if recorder is not None:
-            recorder.finish(failed is None, "" if failed is None else f"{failed}: {reason}")
         res = sm.result(failed, reason)
         if sm.sink is not None:
             sink.end(sm.sink, setup.index, setup.seed, res.success, res.failed_phase, res.reason)
