@@ -119,3 +119,20 @@ def test_gripper_and_grasp_recordings_name_their_phases_and_outcome(tmp_path, mo
     run(load_task(catalog.find("tasks", "grasp")), RunOptions(seed=0, recorder=lambda world: spy))
     assert spy.phases[0] == "plan" and {"approach", "grasp", "lift"} <= set(spy.phases)
     assert spy.outcome == (True, "")  # the session reports the outcome to the recorder
+
+
+def test_default_camera_faces_the_work_area_of_a_kr210(tmp_path):
+    """The KR210's object and place target lie behind it from the default direction: the fitted
+    camera turns so both are in sight, not hidden behind the pedestal."""
+    task = load_task(catalog.find("tasks", "pick_place_kuka_kr210"))
+    with World(task) as world:
+        obj = task.config.pick_place.object
+        world.add_body(obj)
+        rec = Recorder(world, tmp_path / "unused.png", overlay=False)
+        img = rec.render().astype(int)
+        color = (np.asarray(obj.color[:3]) * 255).astype(int)
+        box = np.abs(img - color).max(axis=2) < 60  # lit faces stay near the box's colour
+        assert box.mean() > 0.003, "the object is in sight"
+        px, front = rec.project(np.array([obj.position]))
+        row, col = int(px[0, 1]), int(px[0, 0])
+        assert front.all() and box[max(0, row - 8):row + 8, max(0, col - 8):col + 8].any()  # where it is

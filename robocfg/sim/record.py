@@ -281,11 +281,27 @@ def _work_boxes(world) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def scene_camera(world, size: tuple[int, int] = (320, 240), markers=(), direction=(1.0, -0.8, 0.75),
+DEFAULT_DIRECTION = (1.0, -0.8, 0.75)  # from the scene towards the eye: front right, above
+
+
+def _facing_work(base, work) -> tuple[float, float, float]:
+    """The default view turned about z so that the robot's work area (the object and the place
+    target) is in front of the robot as seen from the camera, not hidden behind its pedestal."""
+    centre = np.mean([(lo + hi) / 2 for lo, hi in work], axis=0)
+    w = centre[:2] - np.asarray(base, float)[:2]
+    if np.linalg.norm(w) < 0.1:
+        return DEFAULT_DIRECTION
+    turn = np.arctan2(w[1], w[0]) + np.arctan2(DEFAULT_DIRECTION[1], DEFAULT_DIRECTION[0])
+    r = float(np.hypot(DEFAULT_DIRECTION[0], DEFAULT_DIRECTION[1]))
+    return (r * float(np.cos(turn)), r * float(np.sin(turn)), DEFAULT_DIRECTION[2])
+
+
+def scene_camera(world, size: tuple[int, int] = (320, 240), markers=(), direction=DEFAULT_DIRECTION,
                  margin: float = 1.1) -> CameraView:
-    """A camera fitted (see :func:`fit_camera`) to the box around every robot and body of the
+    """A camera fitted (see :func:`fit_camera`) to the boxes of every robot link and body of the
     world except the ground, and the markers: a tabletop arm and a KR210 on its pedestal both
-    fill the frame. The robot's box is taken at its current (start) pose."""
+    fill the frame. The robot's boxes are taken at its current (start) pose. With a pick-place
+    task the default direction is turned so the object and the place target face the camera."""
     c = world.client
     skip = {getattr(world, "bodies", {}).get("ground")}
     boxes = []
@@ -298,10 +314,15 @@ def scene_camera(world, size: tuple[int, int] = (320, 240), markers=(), directio
     for m in markers:
         r = np.array([m.radius, m.radius, 0.0])
         boxes.append((np.asarray(m.position) - r, np.asarray(m.position) + r))
-    boxes += _work_boxes(world)
+    work = _work_boxes(world)
+    boxes += work
+    robots = getattr(world, "robots", [])
+    if work and robots and direction == DEFAULT_DIRECTION:
+        direction = _facing_work(robots[0].base_pose()[:3, 3], work)
     lo = np.min([b[0] for b in boxes], axis=0)
     hi = np.max([b[1] for b in boxes], axis=0)
-    return fit_camera(lo, hi, direction, aspect=size[0] / size[1], margin=margin)
+    corners = [[(b[1] if k >> a & 1 else b[0])[a] for a in range(3)] for b in boxes for k in range(8)]
+    return fit_camera(lo, hi, direction, aspect=size[0] / size[1], margin=margin, points=corners)
 
 
 def view_projection(client: int, camera: CameraView, size: tuple[int, int]) -> tuple[list[float], list[float]]:
@@ -360,11 +381,13 @@ def facing_camera(target, side_axis, away_from, distance: float = 0.5, elevation
 
 
 def fit_camera(lo, hi, direction, fov_deg: float = 50.0, aspect: float = 4 / 3, margin: float = 1.08,
-               ) -> CameraView:
-    """A camera looking at the centre of the world box [``lo``, ``hi``] (m) from ``direction``
-    (a vector from the box towards the eye), just far enough away that every corner of the box is
-    in the picture (``margin`` > 1 leaves a border). Works for any robot size, a 1 m tabletop arm
-    or a 3 m KR210 on its pedestal alike."""
+               points=None) -> CameraView:
+    """A camera looking from ``direction`` (a vector from the scene towards the eye) at the world
+    box [``lo``, ``hi``] (m), just far enough away that every corner of the box is in the picture
+    (``margin`` > 1 leaves a border). Works for any robot size, a 1 m tabletop arm or a 3 m KR210
+    on its pedestal alike. ``points`` (N, 3): frame these instead of the box's corners (e.g. the
+    corners of every link's box: seen obliquely, the big box's far corners leave the picture's
+    corners empty); the view is centred on their extent across the image."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     centre = (lo + hi) / 2
     d = np.asarray(direction, float) / np.linalg.norm(direction)
@@ -372,9 +395,16 @@ def fit_camera(lo, hi, direction, fov_deg: float = 50.0, aspect: float = 4 / 3, 
     u = np.cross(f, [0.0, 0.0, 1.0])
     u = np.array([1.0, 0.0, 0.0]) if np.linalg.norm(u) < 1e-9 else u / np.linalg.norm(u)
     v = np.cross(u, f)
+    if points is None:
+        pts = np.array([[(hi if k >> a & 1 else lo)[a] for a in range(3)] for k in range(8)])
+    else:
+        pts = np.asarray(points, float).reshape(-1, 3)
+        rel = pts - centre
+        a, b = rel @ u, rel @ v
+        centre = centre + u * (a.max() + a.min()) / 2 + v * (b.max() + b.min()) / 2
     tv = np.tan(np.radians(fov_deg) / 2)
     th = tv * aspect
-    corners = np.array([[(hi if k >> a & 1 else lo)[a] for a in range(3)] for k in range(8)]) - centre
+    corners = pts - centre
     need = max(float(np.max(np.abs(corners @ u) / th - corners @ f)),
                float(np.max(np.abs(corners @ v) / tv - corners @ f)), 1e-3)
     dist = need * margin
