@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from robocfg.checks import CheckedRobot
-from robocfg.viewer.scene import StillScene
+from robocfg.sim.still_scene import StillScene
 from robocfg.viewer.sheet import robot_sheet
 from robocfg.viewer.source import ViewSource
 

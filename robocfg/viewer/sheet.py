@@ -12,10 +12,10 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import pybullet as p
 from PIL import Image, ImageDraw
 
 from robocfg.sim.record import CameraView, facing_camera, fit_camera, project, render
+from robocfg.sim.still_scene import StillScene
 from robocfg.viewer.frames import ArmFrames, arm_frames, box_corners, pad_boxes_ee
 from robocfg.viewer.overlay import (
     ARROW_COLOR,
@@ -27,7 +27,6 @@ from robocfg.viewer.overlay import (
     draw_frames,
     font,
 )
-from robocfg.viewer.scene import StillScene
 
 PANEL = (560, 420)  # px per view
 TAGS = {"base": "B", "ee_link": "E", "TCP": "T", "grasp": "G"}
@@ -55,14 +54,7 @@ def scene_frames(scene: StillScene, length: float) -> list[ArmFrames]:
 
 def collision_boxes(scene: StillScene) -> list[np.ndarray]:
     """(8, 3) corners of each robot link's collision bounding box (world-aligned, m)."""
-    out = []
-    for robot in scene.robots:
-        for li in robot.link_index.values():
-            if not p.getCollisionShapeData(robot.body_id, li, physicsClientId=scene.client):
-                continue
-            lo, hi = p.getAABB(robot.body_id, li, physicsClientId=scene.client)
-            out.append(box_corners(np.asarray(lo), np.asarray(hi), np.eye(4)))
-    return out
+    return [box_corners(lo, hi, np.eye(4)) for lo, hi in scene.robot_collision_aabbs()]
 
 
 def _tags(frames: list[ArmFrames]) -> dict[str, str]:

@@ -104,6 +104,17 @@ class StillScene:
         hi = np.max([b[1] for b in boxes], axis=0)
         return lo, hi
 
+    def robot_collision_aabbs(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """World axis-aligned box (lo, hi) of every robot link that has a collision shape, m."""
+        out = []
+        for robot in self.robots:
+            for li in robot.link_index.values():
+                if not p.getCollisionShapeData(robot.body_id, li, physicsClientId=self.client):
+                    continue
+                lo, hi = p.getAABB(robot.body_id, li, physicsClientId=self.client)
+                out.append((np.asarray(lo, float), np.asarray(hi, float)))
+        return out
+
     def close(self) -> None:
         if self.world is not None:
             self.world.close()
