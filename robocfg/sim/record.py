@@ -138,7 +138,7 @@ class Recorder:
         robots = getattr(self.world, "robots", [])
         if robots:
             g = robots[0].arm().gripper
-            w = g.width() if g is not None and hasattr(g, "width") else None
+            w = g.width() if g is not None else None
             opening = None if w is None else float(w)
         return FrameInfo(float(getattr(self.world, "t", 0.0)), self.phase, opening)
 

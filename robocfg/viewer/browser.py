@@ -26,6 +26,7 @@ from functools import partial
 import numpy as np
 
 from robocfg.checks import CheckedRobot
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.errors import ConfigError
 from robocfg.geometry.pose import pose_matrix, pose_to_matrix
 from robocfg.geometry.rotation import matrix_to_quat
@@ -160,7 +161,7 @@ class BrowserViewer:
             q = self.q0 if (k == 0 and not self.robots and self.q0 is not None) else arm.home
             out.q.update(zip(robot.arm_joints(arm), (float(v) for v in q), strict=True))
             g = arm.gripper
-            if g is not None and hasattr(g, "open"):
+            if isinstance(g, ParallelGripperConfig):  # one-jaw grippers included (a subclass)
                 out.q.update(zip(robot.gripper_joints(arm), g.open, strict=True))
         return out
 
