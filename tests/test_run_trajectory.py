@@ -126,3 +126,19 @@ def test_stop_at_waypoints_and_jerk_limits_run(tmp_path, capsys, monkeypatch):
 def test_wrong_task_kind_is_rejected(capsys, monkeypatch):
     code, _, err = run_main(["run", "trajectory", "gripper"], capsys, monkeypatch)
     assert code == 2 and "task: trajectory" in err
+
+
+def test_unreachable_waypoint_fails_with_a_report_naming_the_phase(tmp_path, capsys, monkeypatch):
+    """Planning fails before any simulation: exit 1, and --json still holds a report saying why
+    (an older file at that path would otherwise look like this run's result)."""
+    out = tmp_path / "r.json"
+    out.write_text('{"stale": true}')
+    far = "trajectory.waypoints=[home, {position: [2.0, 0.0, 0.4], euler_deg: [180, 0, 0]}, home]"
+    code, stdout, stderr = run_main(["run", "trajectory", "trajectory", "--set", far, "--json", str(out)],
+                                    capsys, monkeypatch)
+    assert code == 1
+    assert "unreachable" in stdout + stderr
+    report = json.loads(out.read_text())
+    assert report["success"] is False and report["kind"] == "trajectory" and report["robot"] == "panda"
+    assert report["phase"] == "waypoints" and "unreachable" in report["reason"]
+    assert report["schema_version"] >= 2

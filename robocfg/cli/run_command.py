@@ -158,7 +158,8 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     from robocfg.engine.options import RunOptions
     from robocfg.engine.registry import command_name
     from robocfg.engine.runner import RunOutput
-    from robocfg.errors import RunFailed
+    from robocfg.errors import PhaseFailed, RunFailed, RunInterrupted
+    from robocfg.runners.report_schema import FailedRunReport
     from robocfg.sim.quiet import quiet_import
 
     kind = runner_type.kind
@@ -177,7 +178,7 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     hook = HOOKS.get(kind)
     if hook is not None:
         runner.options = hook.prepare(checked, runner.options, robot)
-    failed: RunFailed | None = None
+    failed: PhaseFailed | None = None
     lost: list[Any] = []
     with stop_on_signals() as stop, \
             progress_bar(command_name(kind), episodes, runner_type.verb, episodes > 1 and not quiet) as tick:
@@ -190,10 +191,14 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
                                                                ray_address)
             else:
                 output = runner.run()
-        except RunFailed as exc:
-            if exc.report is None:
+        except PhaseFailed as exc:
+            report = exc.report if isinstance(exc, RunFailed) else None
+            if report is None:
+                if not isinstance(exc, RunInterrupted):  # failed before any report existed (e.g. planning)
+                    write_json(json_path, FailedRunReport(kind, str(checked.path), checked.robots[0].config.name,
+                                                          exc.phase, exc.reason))
                 raise
-            failed, output = exc, RunOutput(exc.report)
+            failed, output = exc, RunOutput(report)
     extra_lines = hook.finish(runner.options, output.report) if hook is not None else []
     from robocfg.cli.parallel import lost_lines, with_lost
 

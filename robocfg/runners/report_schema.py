@@ -9,3 +9,22 @@ The JSON Schema of each report: ``robocfg schema report-pick-place`` (and ``repo
 """
 
 REPORT_SCHEMA_VERSION = 2
+
+
+from dataclasses import dataclass, field  # noqa: E402
+
+
+@dataclass
+class FailedRunReport:
+    """What ``--json`` holds when a run failed before it had a report of its own: a phase that
+    needs no simulation (planning a trajectory through an unreachable waypoint, building the
+    world) raised ``(phase, reason)``. ``success`` is false, as in every failed report, so a
+    reader that checks ``success`` needs no special case; ``task`` is the task file's path."""
+
+    kind: str  # the run kind: gripper, trajectory, follow-target, pick-place, grasp
+    task: str
+    robot: str
+    phase: str
+    reason: str
+    success: bool = False
+    schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)
