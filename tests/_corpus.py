@@ -261,6 +261,54 @@ def cli_cases() -> list[Case]:
     ]
 
 
+def _both(name: str, files: dict[str, str], task: str, kind: str, file: str | None, field_: str | None, expect: str,
+          extra: tuple[str, ...] = (), run_extra: tuple[str, ...] = ()) -> list[Case]:
+    """The same input through ``validate`` and ``run KIND``: both must exit 2 with the same
+    located line (``run`` before it simulates; the test makes building a world fail)."""
+    return [Case(f"{name}-validate", files, ["validate", "{dir}/" + task, *extra], 2, file, field_, expect),
+            Case(f"{name}-run", files, ["run", kind, "{dir}/" + task, *extra, *run_extra], 2, file, field_, expect)]
+
+
+def parity_cases() -> list[Case]:
+    """Inputs that ``validate`` once passed and ``run`` then rejected (exit 1 or 2), some only
+    after simulating: each is now rejected by both, at the same FILE:LINE and field."""
+    gr, tr, pp, gs = _task("gripper"), _task("trajectory"), _task("pick_place"), _task("grasp")
+    out: list[Case] = []
+    # A suction gripper is tested by holding an object: without one the run failed in its "place" phase.
+    suction = _set(gr, ("robots", 0, "robot"), "kuka_iiwa_suction")
+    del suction["gripper"]["hold_object"]
+    out += _both("suction-no-hold-object", {"g.yaml": _dump(suction)}, "g.yaml", "gripper", "g.yaml", "gripper.hold_object",
+                 "a suction gripper is tested by holding an object")
+    # An arm joint without a velocity limit: timed moves divide by it (found when the first move was planned).
+    no_vel = _urdf_text(('lower="-3.1416" upper="0.0" velocity="2.1750"', 'lower="-3.1416" upper="0.0" velocity="0"'))
+    robot = _dump(_panda_robot("panda.urdf"))
+    for kind, data in (("trajectory", tr), ("pick-place", pp), ("grasp", gs)):
+        task = _set(data, ("robots", 0), {"robot_config_file": "robot.yaml"})
+        out += _both(f"velocity-limit-missing-{kind}", {"panda.urdf": no_vel, "robot.yaml": robot, "t.yaml": _dump(task)},
+                     "t.yaml", kind, "robot.yaml", "drives.velocity_limits", "joint 'panda_joint4' has no velocity limit")
+    # The same joint given a velocity limit in the robot YAML is fine (validate only: no simulation here).
+    fixed = _panda_robot("panda.urdf")
+    fixed["drives"] = {**fixed.get("drives", {}), "velocity_limits": {"panda_joint4": 2.175}}
+    out.append(Case("velocity-limit-from-drives-ok", {"panda.urdf": no_vel, "robot.yaml": _dump(fixed),
+                                                       "t.yaml": _dump(_set(tr, ("robots", 0), {"robot_config_file": "robot.yaml"}))},
+                    ["validate", "{dir}/t.yaml"], 0))
+    # A variant's value is checked with its robot, and again when that robot runs the task.
+    variant = dict(pp, variants={"ur5e_robotiq_2f85": {"pick_place.lift_height": True}})
+    out += _both("variant-bool-value", {"p.yaml": _dump(variant)}, "p.yaml", "pick-place", "p.yaml",
+                 "variants.ur5e_robotiq_2f85.pick_place.lift_height", "", run_extra=("--robot", "ur5e_robotiq_2f85"))
+    # Fixtures whose parts overlap; an object inside a fixture part.
+    bins = _task("pick_place_bins")
+    clash = copy.deepcopy(bins)
+    clash["scene"]["fixtures"][1]["position"] = list(clash["scene"]["fixtures"][0]["position"])
+    out += _both("fixture-overlap", {"b.yaml": _dump(clash)}, "b.yaml", "pick-place", "b.yaml", "scene.fixtures[1].position",
+                 "overlaps fixture part 'bin_a/floor'")
+    # --set names a field: its value is checked as if written in the file.
+    out += _both("set-hold-object-typo", {"g.yaml": _dump(gr)}, "g.yaml", "gripper", None, None,
+                 "--set gripper.hold_object: no object 'cub' in scene.objects; did you mean 'cube'",
+                 extra=("--set", "gripper.hold_object=cub"))
+    return out
+
+
 def _deep(kind: str) -> str:
     head = "schema_version: 1\ntask: gripper\nrobots:\n  - robot: panda\nscene:\n  objects: "
     if kind == "flow":
@@ -291,7 +339,8 @@ def subprocess_cases() -> list[Case]:
 
 def all_cases() -> list[Case]:
     rng = random.Random(SEED)
-    return [*task_cases(rng), *specific_task_cases(), *robot_cases(), *urdf_cases(), *cli_cases(), *subprocess_cases()]
+    return [*task_cases(rng), *specific_task_cases(), *robot_cases(), *urdf_cases(), *cli_cases(), *parity_cases(),
+            *subprocess_cases()]
 
 
 def write(case: Case, folder: Path) -> list[str]:

@@ -17,13 +17,17 @@ PANDA = ROOT / "robocfg" / "data" / "robots" / "panda.yaml"  # the reference rob
 
 def make_task(tmp_path: Path, robot_file: Path | str, *, objects=(), mount=None, extra=None, task="gripper",
               name: str = "task.yaml"):
-    """Write a minimal ``task: gripper`` YAML using ``robot_file`` (absolute path) and load it."""
+    """Write a minimal ``task: gripper`` YAML using ``robot_file`` (absolute path) and load it.
+
+    A gripper task holds its first object (a suction gripper's test needs one to hold)."""
     data = {
         "schema_version": 1,
         "task": task,
         "robots": [{"robot_config_file": str(Path(robot_file).resolve()), **(mount or {})}],
         "scene": {"ground": True, "objects": list(objects)},
     }
+    if task == "gripper" and objects:
+        data["gripper"] = {"hold_object": objects[0]["name"]}
     for k, v in (extra or {}).items():
         data[k] = v
     path = tmp_path / name

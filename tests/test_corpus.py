@@ -25,9 +25,13 @@ CORPUS_TIMES: dict[str, float] = {}
 def test_corpus_is_large_and_covers_every_kind():
     names = [c.name for c in CASES]
     assert len(CASES) >= 150 and len(set(names)) == len(names)
-    for prefix in ("task-valid", "task-bool", "task-typo", "robot-", "urdf-", "cli-", "deep-", "big-", "hold-object", "wp-"):
+    for prefix in ("task-valid", "task-bool", "task-typo", "robot-", "urdf-", "cli-", "deep-", "big-", "hold-object", "wp-",
+                   "suction-", "velocity-limit-", "variant-", "fixture-", "set-"):
         assert any(n.startswith(prefix) for n in names), prefix
     assert sum(c.exit == 0 for c in CASES) >= 10 and sum(c.exit == 2 for c in CASES) >= 140
+    for c in CASES:  # every input `validate` rejects as a parity case is rejected by `run` too
+        if c.name.endswith("-validate") and c.exit == 2 and not c.subprocess:
+            assert any(d.name == c.name[: -len("validate")] + "run" for d in CASES), c.name
 
 
 def _check(case: Case, folder: Path, code: int, out: str) -> None:
@@ -49,6 +53,12 @@ def _check(case: Case, folder: Path, code: int, out: str) -> None:
 @pytest.mark.parametrize("case", [c for c in CASES if not c.subprocess], ids=lambda c: c.name)
 def test_in_process(case, tmp_path, capsys, monkeypatch):
     args = write(case, tmp_path)
+    if case.args[0] == "run" and case.exit == 2:  # rejected before anything is simulated: no world is built
+        from robocfg.sim.world import World
+
+        def no_world(*a, **k):
+            raise AssertionError(f"{case.name}: a world was built before the run was rejected")
+        monkeypatch.setattr(World, "__init__", no_world)
     t0 = time.perf_counter()
     code, out, err = run_main(args, capsys, monkeypatch)
     CORPUS_TIMES[case.name] = time.perf_counter() - t0

@@ -39,7 +39,8 @@ def test_registry_refuses_an_incomplete_gripper() -> None:
 def test_suction_answers_fraction_width_and_force(tmp_path: Path) -> None:
     from robocfg.sim.world import World
 
-    with World(make_task(tmp_path, DATA / "sim_suction_robot.yaml")) as world:
+    cube = {"name": "cube", "shape": "box", "size": [0.04, 0.04, 0.04], "position": [0.6, 0.3, 0.02]}
+    with World(make_task(tmp_path, DATA / "sim_suction_robot.yaml", objects=[cube])) as world:
         g = world.robot.arm().gripper
         assert g is not None and g.grasps_at_surface
         assert g.width() is None  # no fingers

@@ -13,10 +13,11 @@ from collections.abc import Iterator
 import numpy as np
 
 from robocfg.assets.paths import UnresolvedPath, body_asset
+from robocfg.checks.drives import missing_velocity_limits
 from robocfg.checks.robot import CheckedRobot
 from robocfg.checks.waypoints import PositionLimits, check_joint_waypoints
 from robocfg.config.load import Loc, YamlDocument
-from robocfg.config.robot import ParallelGripperConfig
+from robocfg.config.robot import ParallelGripperConfig, SuctionGripperConfig
 from robocfg.config.scene import Body
 from robocfg.config.task import (
     FollowTargetTask,
@@ -43,6 +44,7 @@ def check_task_params(doc: YamlDocument, task: TaskConfig, robot: CheckedRobot) 
         problems += _check_grasp(doc, task, robot)
     elif isinstance(task, PickPlaceTask):
         problems += _unique_against_scene(doc, task, [(("pick_place", "object"), task.pick_place.object.name)])
+        problems += _timed_arm(robot, None)
     elif isinstance(task, FollowTargetTask):
         obstacles = task.follow_target.obstacles
         problems += _unique_against_scene(doc, task, [(("follow_target", "obstacles", k), o.name) for k, o in enumerate(obstacles)])
@@ -97,6 +99,9 @@ def _check_gripper(doc: YamlDocument, task: GripperTask, robot: CheckedRobot) ->
                                            "'run gripper' needs one")]
     name = task.gripper.hold_object
     known = [b.name for b in task.scene.objects]
+    if name is None and isinstance(g, SuctionGripperConfig):
+        return [doc.problem(("gripper", "hold_object"), "a suction gripper is tested by holding an object: set gripper.hold_object "
+                                                        f"to one of scene.objects (known: {', '.join(known) or 'none'})")]
     if name is not None and name not in known:
         return [doc.problem(("gripper", "hold_object"), f"no object {name!r} in scene.objects{did_you_mean(name, known)} "
                                                         f"(known: {', '.join(known) or 'none'})")]
@@ -114,8 +119,9 @@ def _check_trajectory(doc: YamlDocument, task: TrajectoryTask, robot: CheckedRob
     joints = [robot.urdf.joints[n] for n in names]
     limits = PositionLimits(tuple(names), np.array([j.lower for j in joints]), np.array([j.upper for j in joints]),
                             np.array([j.type != "continuous" for j in joints]))
-    return check_joint_waypoints(list(params.waypoints), limits, np.asarray(arm.home, dtype=float),
-                                 lambda loc, msg: doc.problem(("trajectory", "waypoints", *loc), msg))
+    return _timed_arm(robot, params.arm) + check_joint_waypoints(
+        list(params.waypoints), limits, np.asarray(arm.home, dtype=float),
+        lambda loc, msg: doc.problem(("trajectory", "waypoints", *loc), msg))
 
 
 def _check_grasp(doc: YamlDocument, task: GraspTask, robot: CheckedRobot) -> list[Problem]:
@@ -128,4 +134,9 @@ def _check_grasp(doc: YamlDocument, task: GraspTask, robot: CheckedRobot) -> lis
         out.append(doc.problem(("robots", 0), f"'run grasp' plans two-finger antipodal grasps; robot {robot.config.name!r} "
                                               "has no arm with a parallel gripper"))
     out += _unique_against_scene(doc, task, [(("grasp", "objects", k), b.name) for k, b in enumerate(params.objects)])
-    return out
+    return out + _timed_arm(robot, None)
+
+
+def _timed_arm(robot: CheckedRobot, arm: str | None) -> list[Problem]:
+    """Problems of the arm ``arm`` (None: the first) for timed moves: each joint needs a velocity limit."""
+    return missing_velocity_limits(robot, robot.arm_joints(robot.config.arm(arm)))

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robocfg.checks.drives import missing_velocity_limits, velocity_limit
 from robocfg.errors import ConfigError, Problem
 
 
@@ -69,25 +70,19 @@ def limits_from_robot(robot, joint_names: list[str], params, problem: Callable[[
     ``problem(loc, message)`` builds a located Problem for the robot YAML (defaults to the robot's
     document). Raises ConfigError for a joint whose velocity limit is missing or not > 0.
     """
-    doc = robot.doc
-    make = problem or (lambda loc, msg: doc.problem(loc, msg))
     drives = robot.config.drives
-    problems: list[Problem] = []
+    problems = missing_velocity_limits(robot, joint_names, problem)
+    if problems:
+        raise ConfigError(problems)
+    make = problem or robot.doc.problem
     lower, upper, vel, acc, cont = [], [], [], [], []
     for n in joint_names:
         j = robot.urdf.joints[n]
         lower.append(j.lower)
         upper.append(j.upper)
         cont.append(j.type == "continuous")
-        v = drives.velocity_limits.get(n, j.velocity)
-        if not v > 0:
-            problems.append(make(("drives", "velocity_limits"),
-                                 f"joint {n!r} has no velocity limit (URDF <limit velocity> is {j.velocity:g}); "
-                                 f"give one in drives.velocity_limits.{n} (rad/s, > 0)"))
-        vel.append(v)
+        vel.append(velocity_limit(robot, n))
         acc.append(drives.acceleration_limits.get(n, params.acceleration))
-    if problems:
-        raise ConfigError(problems)
     try:
         base = make_limits(joint_names, lower, upper, vel, acc, params.jerk, cont)
     except ValueError as exc:  # pragma: no cover - pydantic already forbids these
