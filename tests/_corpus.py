@@ -279,6 +279,10 @@ def parity_cases() -> list[Case]:
     del suction["gripper"]["hold_object"]
     out += _both("suction-no-hold-object", {"g.yaml": _dump(suction)}, "g.yaml", "gripper", "g.yaml", "gripper.hold_object",
                  "a suction gripper is tested by holding an object")
+    # A hold object wider than the open gripper: the run failed after simulating ("still between both fingers").
+    wide = _set(gr, ("scene", "objects", 0, "size"), [0.09, 0.1, 0.04])
+    out += _both("hold-object-too-wide", {"g.yaml": _dump(wide)}, "g.yaml", "gripper", "g.yaml", "scene.objects[0].size",
+                 "90.0 mm across its narrowest side, not less than the gripper's max_width 80.0 mm")
     # An arm joint without a velocity limit: timed moves divide by it (found when the first move was planned).
     no_vel = _urdf_text(('lower="-3.1416" upper="0.0" velocity="2.1750"', 'lower="-3.1416" upper="0.0" velocity="0"'))
     robot = _dump(_panda_robot("panda.urdf"))

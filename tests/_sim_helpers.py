@@ -19,7 +19,11 @@ def make_task(tmp_path: Path, robot_file: Path | str, *, objects=(), mount=None,
               name: str = "task.yaml"):
     """Write a minimal ``task: gripper`` YAML using ``robot_file`` (absolute path) and load it.
 
-    A gripper task holds its first object (a suction gripper's test needs one to hold)."""
+    A gripper task holds its first object (a suction gripper's test needs one to hold); with no
+    objects and no ``gripper`` block it is a ``follow_target`` task, a world with just the robot
+    (a gripper task with nothing to hold is invalid for a suction gripper)."""
+    if task == "gripper" and not objects and "gripper" not in (extra or {}):
+        task = "follow_target"
     data = {
         "schema_version": 1,
         "task": task,

@@ -39,10 +39,16 @@ def _half_extents(b: Body) -> np.ndarray:
 
 
 def _box(b: Body, loc: tuple) -> _Box:
-    from robocfg.geometry import pose_matrix
+    """The body's bounding box in the world. A body turned by ``euler_deg`` (or not at all) uses
+    the closed-form roll-pitch-yaw matrix: importing scipy's ``Rotation`` would be most of the
+    time ``validate`` takes to reject a task; quaternions go through it."""
+    from robocfg.geometry import quat_to_matrix, rpy_matrix
 
-    T = pose_matrix(b)
-    return _Box(b.name, loc, T[:3, :3], T[:3, 3], _half_extents(b))
+    if b.quat_xyzw is None and b.quat_wxyz is None:
+        R = rpy_matrix(*np.radians(b.euler_deg or [0.0, 0.0, 0.0]))
+    else:
+        R = quat_to_matrix(b.quaternion_xyzw())
+    return _Box(b.name, loc, R, np.asarray(b.position, dtype=float), _half_extents(b))
 
 
 def overlap_depth(a: _Box, b: _Box) -> float:

@@ -13,7 +13,7 @@ from pydantic import TypeAdapter
 
 from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.scene import check_scene
-from robocfg.checks.task_params import check_task_params
+from robocfg.checks.task_params import check_task_params, narrowest_horizontal
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
 from robocfg.config.overrides import (
@@ -198,7 +198,7 @@ def _check_pick_place(doc: YamlDocument, task: PickPlaceTask, robot: CheckedRobo
         return
     obj = task.pick_place.object
     if isinstance(g, ParallelGripperConfig):
-        narrow = _narrowest_horizontal(obj.shape, obj.size)
+        narrow = narrowest_horizontal(obj.shape, obj.size)
         if narrow >= g.max_width:
             problems.append(doc.problem(("pick_place", "object", "size"),
                                         f"object is {narrow * 1000:.1f} mm across its narrowest side, wider than the gripper's max_width {g.max_width * 1000:.1f} mm"))
@@ -208,8 +208,3 @@ def _check_pick_place(doc: YamlDocument, task: PickPlaceTask, robot: CheckedRobo
         if np.all(np.abs(place[:2] - np.asarray(ob.position[:2])) <= half[:2]):
             warnings.append(doc.problem(("pick_place", "place_position"), f"place position is inside obstacle {ob.name!r} (scene.obstacles[{k}])", "warning"))
 
-
-def _narrowest_horizontal(shape: str, size: list[float]) -> float:
-    if shape in ("box", "mesh"):
-        return min(size[0], size[1])
-    return 2 * size[0]

@@ -105,7 +105,24 @@ def _check_gripper(doc: YamlDocument, task: GripperTask, robot: CheckedRobot) ->
     if name is not None and name not in known:
         return [doc.problem(("gripper", "hold_object"), f"no object {name!r} in scene.objects{did_you_mean(name, known)} "
                                                         f"(known: {', '.join(known) or 'none'})")]
+    if name is not None and isinstance(g, ParallelGripperConfig):
+        k = known.index(name)
+        obj = task.scene.objects[k]
+        narrow = narrowest_horizontal(obj.shape, obj.size)
+        if narrow >= g.max_width:
+            return [doc.problem(("scene", "objects", k, "size"),
+                                f"hold_object {name!r} is {narrow * 1000:.1f} mm across its narrowest side, not less than the "
+                                f"gripper's max_width {g.max_width * 1000:.1f} mm: the fingers cannot close on it")]
     return []
+
+
+def narrowest_horizontal(shape: str, size: list[float]) -> float:
+    """Narrowest horizontal extent (m) of a body as written in the YAML: the smaller of a box's
+    (or mesh's bounding box's) x and y sizes, a sphere's or cylinder's diameter. A parallel
+    gripper closing across a body needs an opening wider than this."""
+    if shape in ("box", "mesh"):
+        return min(size[0], size[1])
+    return 2 * size[0]
 
 
 def _check_trajectory(doc: YamlDocument, task: TrajectoryTask, robot: CheckedRobot) -> list[Problem]:

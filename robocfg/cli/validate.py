@@ -22,7 +22,6 @@ def validate(
     --set, each task file is checked with those fields changed (robot files as they are)."""
     from rich.table import Table
 
-    from robocfg.checks import load_robot, load_task
     from robocfg.cli.errors import format_problem
     from robocfg.config import catalog
     from robocfg.config.load import detect_kind, load_yaml
@@ -41,6 +40,10 @@ def validate(
             if f.is_dir():  # _collect keeps a folder only when it holds no YAML: nothing checked is no "ok"
                 raise ConfigError([Problem(str(f), None, None, "", "no YAML files (*.yaml, *.yml) in this folder")])
             kind = detect_kind(load_yaml(f))
+            # The checks (numpy, URDF parsing, the task models) are imported once a file has parsed:
+            # a file refused by the size and nesting pre-scan is reported without them.
+            from robocfg.checks import load_robot, load_task
+
             checked = load_robot(f, strict) if kind == "robot" else load_task(f, strict, overrides=changes)
             warnings = checked.warnings
         except ConfigError as exc:
