@@ -108,7 +108,12 @@ def test_checkout_robots_folder_is_the_users_not_the_builtins():
         d = ROOT / folder
         assert d.is_dir() and not d.is_symlink(), folder
         assert not list(d.glob("*.yaml")), f"built-in YAMLs belong in robocfg/data/{folder}"
-    assert catalog.BUILTIN_DIR == ROOT / "robocfg" / "data"
+    # built-ins are the package's own data (the checkout's with an editable install, site-packages'
+    # with a plain `pip install .` as CI does), never the checkout's top-level user folders
+    import robocfg
+
+    assert Path(robocfg.__file__).resolve().parent / "data" == catalog.BUILTIN_DIR
+    assert catalog.BUILTIN_DIR.resolve() not in {(ROOT / "robots").resolve(), (ROOT / "tasks").resolve()}
 
 
 def test_new_robot_in_a_checkout_writes_to_the_users_folder(capsys, monkeypatch, tmp_path):
