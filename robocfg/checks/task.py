@@ -11,9 +11,10 @@ from typing import Any
 import numpy as np
 from pydantic import TypeAdapter
 
+from robocfg.checks.object_fit import check_object_fit
 from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.scene import check_scene
-from robocfg.checks.task_params import check_task_params, narrowest_horizontal
+from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
 from robocfg.config.load import YamlDocument, load_yaml, validate_document
 from robocfg.config.overrides import (
@@ -22,7 +23,6 @@ from robocfg.config.overrides import (
     blame_overrides,
     parse_key,
 )
-from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
 from robocfg.errors import ConfigError, NotFound, Problem
 from robocfg.suggest import did_you_mean
@@ -196,12 +196,8 @@ def _check_pick_place(doc: YamlDocument, task: PickPlaceTask, robot: CheckedRobo
     if g is None:
         problems.append(doc.problem(("robots", 0), f"robot {robot.config.name!r} has no gripper (arms[0].gripper is missing in {robot.path}); pick-place needs one"))
         return
-    obj = task.pick_place.object
-    if isinstance(g, ParallelGripperConfig):
-        narrow = narrowest_horizontal(obj.shape, obj.size)
-        if narrow >= g.max_width:
-            problems.append(doc.problem(("pick_place", "object", "size"),
-                                        f"object is {narrow * 1000:.1f} mm across its narrowest side, wider than the gripper's max_width {g.max_width * 1000:.1f} mm"))
+    for problem in check_object_fit(doc, task, robot, arm):
+        (warnings if problem.severity == "warning" else problems).append(problem)
     place = np.asarray(task.pick_place.place_position)
     for k, ob in enumerate(task.scene.obstacles):
         half = np.asarray(ob.size if ob.shape == "box" else [ob.size[0] * 2] * 3) / 2

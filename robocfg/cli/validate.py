@@ -46,6 +46,10 @@ def validate(
 
             checked = load_robot(f, strict) if kind == "robot" else load_task(f, strict, overrides=changes)
             warnings = checked.warnings
+            if kind == "task":  # poses out of the arm's reach (IK, no simulation)
+                from robocfg.motion.reach import reach_warnings
+
+                warnings = warnings + reach_warnings(checked)  # type: ignore[arg-type]
         except ConfigError as exc:
             problems = exc.problems
         errors = [p for p in problems if p.severity == "error"]

@@ -164,27 +164,30 @@ class PickPlaceRandomize(Frozen):
 
 
 class PhaseTimeouts(Frozen):
-    """Per-phase time limits (s): how long each phase may take before the episode fails in it."""
+    """Per-phase time limits (s): how long each phase may take before the episode fails in it. A
+    motion phase without one gets its planned motion's duration plus a margin; grasp and release
+    have no motion to plan and keep a fixed limit."""
 
-    pre_grasp: PositiveFloat = 4.0
-    approach: PositiveFloat = 3.0
-    grasp: PositiveFloat = 1.5
-    lift: PositiveFloat = 3.0
-    transport: PositiveFloat = 4.0
-    lower: PositiveFloat = 3.0
-    release: PositiveFloat = 1.5
-    retract: PositiveFloat = 3.0
+    pre_grasp: PositiveFloat | None = Field(None, description="Time limit (s) of this motion; leave it out to allow the planned motion's duration × 1.25 + 1 s, so a slow arm is not failed for being slow.")
+    approach: PositiveFloat | None = Field(None, description="Time limit (s) of this motion; leave it out to allow the planned motion's duration × 1.25 + 1 s, so a slow arm is not failed for being slow.")
+    grasp: PositiveFloat = Field(1.5, description="Time (s) allowed for the fingers to close on the object.")
+    lift: PositiveFloat | None = Field(None, description="Time limit (s) of this motion; leave it out to allow the planned motion's duration × 1.25 + 1 s, so a slow arm is not failed for being slow.")
+    transport: PositiveFloat | None = Field(None, description="Time limit (s) of this motion; leave it out to allow the planned motion's duration × 1.25 + 1 s, so a slow arm is not failed for being slow.")
+    lower: PositiveFloat | None = Field(None, description="Time limit (s) of this motion; leave it out to allow the planned motion's duration × 1.25 + 1 s, so a slow arm is not failed for being slow.")
+    release: PositiveFloat = Field(1.5, description="Time (s) allowed for the object to come free.")
+    retract: PositiveFloat | None = Field(None, description="Time limit (s) of this motion; leave it out to allow the planned motion's duration × 1.25 + 1 s, so a slow arm is not failed for being slow.")
 
 
 class PickPlaceParams(Frozen):
     """``run pick-place``: the 8-phase pick-and-place state machine."""
 
     object: Body = Field(description="The object to pick (spawned resting on its support).")
-    place_position: Vec3 = Field(description="Where the object's centre should end (m, world); z is ignored (it rests on the support).")
+    place_position: Vec3 = Field(description="Where the object's centre should end (m, world; see placement); z is ignored (it rests on the support).")
+    placement: Literal["world", "reach"] = Field("world", description="world: object.position and place_position are world coordinates (m). reach: their x and y are in the robot's base frame (x forward, as mounted), in units of the arm's reach with the tool pointing down (e.g. [0.6, -0.2]), so one task fits a desk arm and an industrial arm alike; the randomisation ranges stay in metres.")
     randomize: PickPlaceRandomize = Field(default_factory=PickPlaceRandomize)
     above_height: PositiveFloat = Field(0.15, description="TCP height above the grasp point for pre-grasp/transport (m).")
     lift_height: PositiveFloat = Field(0.15, description="How far the object is lifted (m).")
-    grasp_depth: FiniteFloat = Field(0.0, description="TCP height of the grasp relative to the object centre (m).")
+    grasp_depth: FiniteFloat | None = Field(None, description="TCP height of the grasp relative to the object centre (m); leave it out to have it chosen from the object's and the gripper's geometry (mid-height, or near the top of a tall object so the palm stays clear).")
     position_tolerance: PositiveFloat = Field(0.005, description="Phase convergence: TCP position error (m).")
     orientation_tolerance: PositiveFloat = Field(0.05, description="Phase convergence: TCP orientation error (rad).")
     timeouts: PhaseTimeouts = Field(default_factory=PhaseTimeouts)

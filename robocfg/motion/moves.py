@@ -35,6 +35,10 @@ CARTESIAN_STEP = 0.03  # m between IK waypoints on straight lines
 SETTLE_POLL = 4  # physics steps between convergence checks
 MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
 DIRECT_TRAVEL_CHECK = 1.0  # rad: a point-to-point IK answer this far away is compared with a continuous one
+TIMEOUT_FACTOR = 1.25  # a move without a fixed timeout may take its planned duration × this ...
+TIMEOUT_MARGIN = 1.0  # ... + this many seconds (s) to settle and converge
+UNPLANNED_TIMEOUT = 4.0  # s: the limit of a move that has no plan to measure (convergence only)
+REACTIVE_DETOUR = 2.0  # a reactive move may take this many times the direct move (it goes round obstacles)
 IK_ITERATIONS = 400  # LM iterations per IK query over all restarts (see bound_ik_by_iterations)
 
 
@@ -63,7 +67,8 @@ def grasp_hint(arm: ArmHandle, width: float | None) -> str:
 @dataclass
 class ArmMover:
     """Moves one arm of ``world``. ``model``: KinematicModel of the arm; ``limits``: JointLimits
-    for timing; tolerances in m and rad; ``timeout`` (s) per move; ``on_step`` after every physics
+    for timing; tolerances in m and rad; ``timeout`` (s) per move, or None: each move may take its
+    planned duration × ``TIMEOUT_FACTOR`` + ``TIMEOUT_MARGIN`` (a slow arm is slow, not failed); ``on_step`` after every physics
     step (e.g. a recorder); ``phase`` names the current phase in failures."""
 
     world: World
@@ -72,7 +77,7 @@ class ArmMover:
     limits: JointLimits
     position_tolerance: float = 0.005
     orientation_tolerance: float = 0.05
-    timeout: float = 4.0
+    timeout: float | None = 4.0
     on_step: Callable[[], None] | None = None
     phase: str = "move"
     ik_budget: float = 1.0  # s of wall clock per IK query: a safety net (bound_ik_by_iterations binds)
@@ -124,11 +129,11 @@ class ArmMover:
             W = np.asarray([q0, q_goal])
         if np.max(np.abs(W[-1] - W[0])) >= 1e-6:
             traj = MinJerkPath(W, self.limits)
-            if traj.duration > self.timeout:
+            if self.timeout is not None and traj.duration > self.timeout:
                 raise MoveFailed(self.phase, f"motion needs {traj.duration:.2f} s, more than the {self.timeout:.2f} s timeout")
             t_start = self.world.t
             self.play(traj)
-            self.converge(T_goal, t_start)
+            self.converge(T_goal, t_start, self.time_limit(traj.duration))
         if check is not None:
             reason = check()
             if reason:
@@ -139,6 +144,7 @@ class ArmMover:
         :class:`~robocfg.motion.reactive_drive.ReactiveDrive`), which keeps the arm clear of the
         scene; same convergence tolerances, ``timeout`` and ``check()`` as :meth:`move`."""
         ctrl, T_tcp = drive.controller, T_goal @ drive.T_ee_tcp
+        limit = self.time_limit(self._direct_duration(T_goal), REACTIVE_DETOUR)
         ctrl.reset(self.arm.joint_positions())
         t_start, still = self.world.t, np.zeros(6)
         while True:
@@ -147,8 +153,8 @@ class ArmMover:
             dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
             if dp <= self.position_tolerance and dr <= self.orientation_tolerance:
                 break
-            if self.world.t - t_start > self.timeout:
-                raise MoveFailed(self.phase, f"did not converge within {self.timeout:.1f} s "
+            if self.world.t - t_start > limit:
+                raise MoveFailed(self.phase, f"did not converge within {limit:.1f} s "
                                              f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
             res = ctrl.step(T_tcp, q_measured=self.arm.joint_positions(), velocity=still)
             self.arm.command(res.q, res.dq)
@@ -170,15 +176,38 @@ class ArmMover:
             self.arm.command(q_ref[k], qd_ref[k])
             self.step(1)
 
-    def converge(self, T_goal: np.ndarray, t_start: float) -> None:
+    def time_limit(self, planned: float | None, factor: float = 1.0) -> float:
+        """Time (s) a move may take: the fixed ``timeout``, else the planned duration (s) ×
+        ``factor`` × ``TIMEOUT_FACTOR`` + ``TIMEOUT_MARGIN`` (settling and convergence)."""
+        if self.timeout is not None:
+            return self.timeout
+        if planned is None:
+            return UNPLANNED_TIMEOUT
+        return planned * factor * TIMEOUT_FACTOR + TIMEOUT_MARGIN
+
+    def _direct_duration(self, T_goal: np.ndarray) -> float | None:
+        """Duration (s) of the direct joint-space move to ``T_goal`` (None when IK fails): the
+        yardstick for a reactive move's time limit."""
+        from robocfg.motion.minjerk_path import MinJerkPath
+
+        if self.timeout is not None:
+            return None
+        q0 = self.arm.joint_positions()
+        res = self.model.ik(T_goal, seed_q=q0, frame="ee", time_budget=self.ik_budget)
+        if not res.converged or np.max(np.abs(res.q - q0)) < 1e-6:
+            return None
+        return float(MinJerkPath(np.asarray([q0, res.q]), self.limits).duration)
+
+    def converge(self, T_goal: np.ndarray, t_start: float, limit: float | None = None) -> None:
+        limit = self.time_limit(None) if limit is None else limit
         while True:
             T = self.arm.ee_pose()
             dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
             dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
             if dp <= self.position_tolerance and dr <= self.orientation_tolerance:
                 return
-            if self.world.t - t_start > self.timeout:
-                raise MoveFailed(self.phase, f"did not converge within {self.timeout:.1f} s "
+            if self.world.t - t_start > limit:
+                raise MoveFailed(self.phase, f"did not converge within {limit:.1f} s "
                                              f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
             self.step(SETTLE_POLL)
 

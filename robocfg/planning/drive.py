@@ -102,12 +102,12 @@ class PlannedDrive:
             raise PhaseFailed(mover.phase, exc.reason) from None
         self.paths.append(path)
         plan = self.planner.timed(path, mover.limits)
-        if plan.duration > mover.timeout:
+        if mover.timeout is not None and plan.duration > mover.timeout:
             raise PhaseFailed(mover.phase, f"motion needs {plan.duration:.2f} s, more than the {mover.timeout:.2f} s timeout")
         t_start = mover.world.t
         if plan.duration > 0:
             mover.play(plan.trajectory)
-        mover.converge(T_goal, t_start)
+        mover.converge(T_goal, t_start, mover.time_limit(plan.duration))
         if check is not None:
             reason = check()
             if reason:

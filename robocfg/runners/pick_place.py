@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from robocfg.config.commands import Limits, PickPlaceParams
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.engine.options import FrameRecorder, RunOptions, option
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
@@ -25,6 +26,7 @@ from robocfg.runners.pick_place_machine import (
     EpisodeSetup,
     _StateMachine,
     _Tools,
+    not_simulated,
     planned_drive,
     reactive_drive,
 )
@@ -76,23 +78,37 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
     """The pick-place world, kinematic model and limits, shared by every episode."""
 
     def prepare(self) -> None:
+        from robocfg.assets.object_shape import object_shape
+        from robocfg.grasp.gripper_model import measure_gripper
         from robocfg.kinematics.model import KinematicModel
         from robocfg.motion.limits import limits_from_robot
+        from robocfg.motion.placement import resolved_params
+        from robocfg.motion.reach import pick_place_reach
 
-        self.params: PickPlaceParams = self.task.config.pick_place  # type: ignore[union-attr]
         robot = self.task.robots[0]
         self.arm_cfg = robot.config.arm(self.options.arm)
+        self.params: PickPlaceParams = resolved_params(self.task, self.arm_cfg.name)  # world positions
         self.handle = self.world.robot.arm(self.arm_cfg.name)
+        shape = object_shape(self.params.object, self.task.path.parent)
+        obj = self.params.object
+        if shape.file_mass is not None and "mass" not in obj.model_fields_set:  # the URDF's own mass
+            self.params = self.params.model_copy(update={"object": obj.model_copy(update={"mass": shape.file_mass})})
+        # Poses out of reach (IK, before simulating): a nominal one fails every episode unsimulated.
+        self.reach = pick_place_reach(self.task, self.arm_cfg.name, self.params)
+        self.blocked = next((r for r in self.reach if r.nominal), None)
         model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
         bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
         scale = self.params.speed_scale
+        boxes = measure_gripper(self.world.robot, self.handle) if isinstance(self.arm_cfg.gripper, ParallelGripperConfig) else None
         self.tools = _Tools(model, limits_from_robot(robot, self.handle.joints,
                                                      Limits(velocity_scale=scale, acceleration_scale=scale)),
-                            reactive_drive(robot, self.world, self.arm_cfg.name, self.params),
-                            planned_drive(robot, self.world, model, self.params))
+                            reactive_drive(robot, self.world, self.arm_cfg.name, self.params, shape),
+                            planned_drive(robot, self.world, model, self.params), shape=shape, boxes=boxes)
 
     def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
         setup = episode_setup(self.params, self.seed, k)
+        if self.blocked is not None:
+            return not_simulated(setup, self.blocked.phase, f"{self.blocked.reason}; checked before simulating")
         self.remove_after_episode(setup.body.name)  # the state machine spawns it
         sm = _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k))
         sink = self.options.sink
@@ -115,6 +131,7 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         warnings += [f"obstacle {name!r} is a mesh: the reactive controller does not avoid it" for name in skipped]
         unseen = self.tools.planned.skipped if self.tools.planned is not None else []
         warnings += [f"body {name!r} is a mesh: the planner does not avoid it" for name in unseen]
+        warnings += [r.problem(self.task).format() for r in self.reach]
         return PickPlaceReport(task=str(self.task.path), robot=self.task.robots[0].config.name,
                                arm=self.arm_cfg.name, seed=self.seed, summary=summarise(records), episodes=records,
                                warnings=warnings, interrupted=interrupted)

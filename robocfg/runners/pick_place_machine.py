@@ -1,7 +1,7 @@
 """The 8-phase pick-and-place state machine of one episode (``run pick-place``).
 
-Every target comes from the robot YAML through one conversion: a top-down GraspNet grasp
-(approach straight down, fingers closing across the object's narrower horizontal side) →
+Every target comes from the robot YAML through one conversion: a GraspNet grasp chosen from the
+object's real geometry and the gripper's measured one (:mod:`robocfg.grasp.object_grasp`) →
 ``ee_pose_from_grasp`` (``R_ee_graspnet``, ``ee_axis``, ``tcp_offset``) → IK (continuous along
 straight TCP lines) → min-jerk timed joint trajectories → position drives, all through
 :class:`robocfg.motion.moves.ArmMover`. With ``motion: reactive`` the two free-space moves
@@ -19,10 +19,19 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from robocfg.assets.object_shape import ObjectShape, object_shape
 from robocfg.config.commands import PickPlaceParams
 from robocfg.config.scene import Body
-from robocfg.geometry import rotation_angle
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, top_down_grasps
+from robocfg.geometry import quat_to_matrix, rotation_angle
+from robocfg.grasp.gripper_model import GripperBoxes
+from robocfg.grasp.object_grasp import (
+    LyingObject,
+    mesh_grasps,
+    suction_grasps,
+    top_down_groups,
+    usable_width,
+)
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
 from robocfg.motion.moves import ArmMover, MoveFailed, grasp_hint
 from robocfg.runners.pick_place_report import EpisodeResult, PhaseRecord
 
@@ -33,6 +42,10 @@ Log = Callable[[str], None]
 SETTLE_POLL = 4  # physics steps between checks while waiting
 RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
 SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
+# Bullet lets a ball or a lying cylinder creep and roll away on a level plane from rest; a little
+# rolling/spinning friction (m) on round objects stops that artefact without changing the grasp.
+ROLLING_FRICTION = 1e-3
+REST_TOLERANCE = 1e-4  # m: an object spawned further than this from resting on its support is moved onto it
 
 
 @dataclass(frozen=True)
@@ -48,26 +61,43 @@ class EpisodeSetup:
 
 @dataclass(frozen=True)
 class _Tools:
-    """Per-run helpers shared by every episode: kinematic model, scaled joint limits and, with
-    ``motion: reactive``, the follow-target controller driving the free-space moves (with ``motion:
-    planned``, the global planner)."""
+    """Per-run helpers shared by every episode: kinematic model, scaled joint limits, with
+    ``motion: reactive`` the follow-target controller driving the free-space moves (with ``motion:
+    planned``, the global planner), the object's geometry
+    (:class:`~robocfg.assets.object_shape.ObjectShape`; None: read from the episode's body) and the
+    parallel gripper's measured boxes (:class:`~robocfg.grasp.gripper_model.GripperBoxes`; None for
+    suction)."""
 
     model: Any
     limits: Any
     reactive: Any = None
     planned: Any = None  # motion: planned — a robocfg.planning.drive.PlannedDrive
+    shape: ObjectShape | None = None
+    boxes: GripperBoxes | None = None
 
 
-def reactive_drive(robot, world: World, arm_name: str, params: PickPlaceParams):
+def reactive_drive(robot, world: World, arm_name: str, params: PickPlaceParams, shape: ObjectShape):
     """The controller for ``motion: reactive`` (built once per run: it is expensive), else None."""
     if params.motion != "reactive":
         return None
-    from robocfg.motion.reactive_drive import bounding_radius, build_reactive_drive
+    from robocfg.motion.reactive_drive import build_reactive_drive
 
-    obj = params.object  # held object's centre beyond the TCP, along the tool axis (m)
-    beyond = obj.half_height() - SUCTION_PRESS if world.robot.arm(arm_name).require_gripper().grasps_at_surface else params.grasp_depth
-    return build_reactive_drive(robot, world, arm_name, velocity_scale=params.speed_scale,
-                                payload=(beyond, bounding_radius(obj)))
+    # the held object's centre beyond the TCP along the tool axis (m), and its bounding radius (m)
+    top = float(shape.posed(quat_to_matrix(params.object.quaternion_xyzw()))[:, 2].max())
+    beyond = top - SUCTION_PRESS if world.robot.arm(arm_name).require_gripper().grasps_at_surface else 0.0
+    radius = float(np.max(np.linalg.norm(shape.vertices, axis=1)))
+    return build_reactive_drive(robot, world, arm_name, velocity_scale=params.speed_scale, payload=(beyond, radius))
+
+
+def not_simulated(s: EpisodeSetup, phase: str, reason: str) -> EpisodeResult:
+    """The record of an episode failed before simulating (the object never moved)."""
+    start = [round(float(v), 6) for v in s.body.position]
+    return EpisodeResult(
+        index=s.index, seed=s.seed, success=False, failed_phase=phase, reason=reason, object_start=start,
+        object_start_yaw_deg=round(math.degrees(s.yaw), 4), place_target=[round(float(v), 6) for v in s.place_xy],
+        object_final=start, place_error=round(float(np.linalg.norm(np.asarray(start[:2]) - s.place_xy)), 6),
+        tilt_deg=0.0, lift_rise=None, mass=round(s.body.mass, 6), friction=round(s.body.friction, 6),
+        sim_time=0.0, steps=0, phases=[])
 
 
 def planned_drive(robot, world: World, model, params: PickPlaceParams):
@@ -94,7 +124,12 @@ class _StateMachine:
                               params.orientation_tolerance, on_step=self._on_step, phase="setup")
         if params.grip_force is not None:
             self.gripper.set_force(params.grip_force)
+        self.shape = tools.shape or object_shape(setup.body, world.task.path.parent)
+        self.boxes = tools.boxes
         self.obj = world.add_body(setup.body)
+        if self.shape.symmetry != "none":
+            world.set_dynamics(self.obj, rolling_friction=ROLLING_FRICTION, spinning_friction=ROLLING_FRICTION)
+        self.R0 = self._rest_on_support()
         self.phases: list[PhaseRecord] = []
         self._phase: tuple[str, float] | None = None
         self.lift_rise: float | None = None
@@ -105,13 +140,11 @@ class _StateMachine:
         p = self.params
         self.gripper.open()
         self.mover.settle(0.2)
-        obj_pos, _ = self.world.body_pose(self.obj)
-        self.support_z = obj_pos[2] - self.setup.body.half_height()
-        if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
-            center = obj_pos + np.array([0, 0, self.setup.body.half_height() - SUCTION_PRESS])
-        else:
-            center = obj_pos + np.array([0, 0, p.grasp_depth])
-        grasp = self._choose_grasp(center)
+        obj_pos, obj_quat = self.world.body_pose(self.obj)
+        self.R0 = quat_to_matrix(obj_quat)  # as it came to rest: what the place must reproduce
+        lying = LyingObject(self.shape, obj_pos, quat_to_matrix(obj_quat), self._support_height(obj_pos[:2]))
+        self.support_z = lying.support_z
+        grasp = self._choose_grasp(lying)
         T_grasp = ee_pose_from_grasp(grasp, self.cfg)
         T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
 
@@ -120,7 +153,7 @@ class _StateMachine:
         self.begin("approach", "down to grasp height")
         self.mover.move(T_grasp, straight=True)
         self.begin("grasp", "close the gripper")
-        self.mover.close_until_held(self.obj, self.mover.timeout)
+        self.mover.close_until_held(self.obj, p.timeouts.grasp)
         self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
         z0 = self.world.body_pose(self.obj)[0][2]
         T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
@@ -130,7 +163,7 @@ class _StateMachine:
         obj_now = self.world.body_pose(self.obj)[0]
         ee_now = self.arm.ee_pose()[:3, 3]
         offset = ee_now - obj_now
-        place_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height() + RELEASE_CLEARANCE
+        place_z = self._support_height(self.setup.place_xy) + self.shape.below_origin(self.R0) + RELEASE_CLEARANCE
         place_obj = np.array([*self.setup.place_xy, place_z])
         T_place = T_lift.copy()
         T_place[:3, 3] = place_obj + offset
@@ -188,20 +221,21 @@ class _StateMachine:
         T_obj[:3, :3], T_obj[:3, 3] = quat_to_matrix(quat), pos
         self.planned.attach(self.setup.body.name, self.setup.body, np.linalg.inv(self.arm.ee_pose()) @ T_obj)
 
-    def _choose_grasp(self, center: np.ndarray) -> Grasp:
-        """Of the two top-down grasps, the one needing the least joint travel (largest |Δq|, rad)
-        to reach the pre-grasp pose and from there the pose above the place point; the smaller
-        wrist turn breaks ties. (IK can land on a far branch for one of the two, e.g. a Panda's
-        shoulder flipped by ≈ 3 rad, or a wrist that must wind round a joint limit to carry.)"""
-        b = self.setup.body
-        extent = (b.size[0], b.size[1]) if b.shape in ("box", "mesh") else (2 * b.size[0], 2 * b.size[0])
+    def _choose_grasp(self, lying: LyingObject) -> Grasp:
+        """A grasp chosen from the object's geometry (:mod:`robocfg.grasp.object_grasp`): groups of
+        candidates, best first; within the first group that the arm can reach, the one needing the
+        least joint travel (largest |Δq|, rad) to reach the pre-grasp pose and from there the pose
+        above the place point; the smaller wrist turn breaks ties. (IK can land on a far branch for
+        one of two half-turn twins, e.g. a Panda's shoulder flipped by ≈ 3 rad, or a wrist that
+        must wind round a joint limit to carry.)"""
+        groups = self._grasp_groups(lying)
+        if not groups:
+            raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
         R_now = self.arm.ee_pose()[:3, :3]
-        cands = sorted(top_down_grasps(center, self.setup.yaw, extent),
-                       key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
         q0 = self.arm.joint_positions()
-        shift = np.array([*(self.setup.place_xy - center[:2]), 0.0])
 
         def travel(g: Grasp) -> float:
+            shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
             T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
             cost, q = 0.0, q0
             for T in (T_pre, _shifted(T_pre, shift)):
@@ -211,14 +245,53 @@ class _StateMachine:
                 cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
             return cost
 
-        costs = [travel(g) for g in cands]
-        return cands[int(np.argmin(costs))] if min(costs) < math.inf else cands[0]
+        for group in groups:
+            cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+            costs = [travel(g) for g in cands]
+            if min(costs) < math.inf:
+                return cands[int(np.argmin(costs))]
+        return groups[0][0]
+
+    def _grasp_groups(self, lying: LyingObject) -> list[list[Grasp]]:
+        """Candidate grasps from the object's geometry, grouped, best group first."""
+        p = self.params
+        if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
+            return [suction_grasps(lying, SUCTION_PRESS)]
+        if self.boxes is None:
+            raise MoveFailed("grasp_choice", "the gripper's geometry was not measured")
+        groups = top_down_groups(lying, self.boxes)
+        if p.grasp_depth is not None:  # the task fixes the TCP height relative to the object's centre
+            z = float(lying.position[2]) + p.grasp_depth
+            groups = [[Grasp(np.array([*g.center[:2], z]), g.rotation, g.width) for g in grp] for grp in groups]
+        if self.setup.body.shape == "mesh":
+            rng = np.random.default_rng([self.setup.seed, 1])
+            meshes = mesh_grasps(lying, self.boxes, rng, p.above_height)
+            groups = [[g, _half_turn(g)] for g in meshes] + groups
+        return groups
+
+    def _no_grasp_reason(self, lying: LyingObject) -> str:
+        if self.boxes is None:
+            return "no grasp found"
+        narrow = lying.shape.min_horizontal_width(lying.rotation)
+        return (f"no grasp found: the object ({narrow * 1000:.1f} mm across its narrowest horizontal side) "
+                f"does not fit the open fingers ({usable_width(self.boxes) * 1000:.1f} mm usable)")
+
+    def _rest_on_support(self) -> np.ndarray:
+        """Put the object on the surface below it (its lowest point on the support, whatever its
+        shape and the height the task gave) and return its rotation (3x3)."""
+        pos, quat = self.world.body_pose(self.obj)
+        R = quat_to_matrix(quat)
+        self.support_z = float(pos[2]) - self.shape.below_origin(R)  # as the task put it, if nothing is below
+        z = self._support_height(pos[:2]) + self.shape.below_origin(R)
+        if abs(z - pos[2]) > REST_TOLERANCE:
+            self.world.set_body_pose(self.obj, [pos[0], pos[1], z], quat)
+        return R
 
     def _release(self) -> None:
         t0 = self.world.t
         self.gripper.open()
         while self._held() or self.gripper.fraction() < 0.9:
-            if self.world.t - t0 > self.mover.timeout:
+            if self.world.t - t0 > self.params.timeouts.release:
                 raise MoveFailed("release", "the object did not come free")
             self.mover.step(SETTLE_POLL)
 
@@ -264,7 +337,7 @@ class _StateMachine:
         pos, quat = self.world.body_pose(self.obj)
         err = float(np.linalg.norm(pos[:2] - self.setup.place_xy))
         tilt = self._tilt(quat)
-        rest_z = self._support_height(self.setup.place_xy) + self.setup.body.half_height()
+        rest_z = self._support_height(self.setup.place_xy) + self.shape.below_origin(quat_to_matrix(quat))
         if err > p.success_tolerance:
             raise MoveFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
         if tilt > p.max_tilt_deg:
@@ -272,12 +345,10 @@ class _StateMachine:
         if abs(pos[2] - rest_z) > 0.01:
             raise MoveFailed("place", f"object not resting on the support (centre {pos[2] * 100:.1f} cm, expected {rest_z * 100:.1f} cm)")
 
-    @staticmethod
-    def _tilt(quat) -> float:
-        from robocfg.geometry import quat_to_matrix
-
-        z = quat_to_matrix(quat)[:, 2]
-        return math.degrees(math.acos(max(-1.0, min(1.0, float(z[2])))))
+    def _tilt(self, quat) -> float:
+        """Degrees the object has tipped from how it lay at the start (yaw free; see
+        :meth:`~robocfg.assets.object_shape.ObjectShape.tilt_deg`)."""
+        return self.shape.tilt_deg(self.R0, quat_to_matrix(quat))
 
     def result(self, failed: str | None, reason: str) -> EpisodeResult:
         pos, quat = self.world.body_pose(self.obj)
@@ -294,6 +365,11 @@ class _StateMachine:
             mass=round(b.mass, 6), friction=round(b.friction, 6),
             sim_time=round(self.world.t, 6), steps=self.world.steps, phases=self.phases,
         )
+
+
+def _half_turn(g: Grasp) -> Grasp:
+    """The same grasp turned half a turn about its approach axis (fingers swapped)."""
+    return Grasp(g.center, g.rotation @ np.diag([1.0, -1.0, -1.0]), g.width)
 
 
 def _shifted(T: np.ndarray, d) -> np.ndarray:

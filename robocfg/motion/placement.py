@@ -1,0 +1,111 @@
+"""Pick-place spots given relative to the robot (``placement: reach``), turned into world points.
+
+With ``placement: reach`` a task gives ``object.position`` and ``place_position`` as (x, y) in the
+robot's base frame (x forward, as mounted) in units of the arm's *reach*: the farthest horizontal
+distance from the base at which the tool, pointing straight down, reaches the object's grasp
+height and the pre-grasp height above it (IK, before simulating). So ``[0.6, -0.2]`` is 60 % of
+the reach forward and 20 % to the right, for a desk arm and for an industrial arm on a pedestal
+alike; the randomisation ranges stay in metres (they are about the object, not the robot).
+
+Frames: world, metres.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from robocfg.assets.object_shape import object_shape
+from robocfg.checks.task import CheckedTask
+from robocfg.config.commands import PickPlaceParams
+from robocfg.config.robot import SuctionGripperConfig
+from robocfg.geometry import pose_matrix, quat_to_matrix
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
+
+FK_SAMPLES = 400  # random configurations bounding how far the tool can get from the base
+SCAN_STEPS = 24  # distances tried from that bound inwards
+REFINE_STEPS = 6  # bisection steps between the last reachable and the first unreachable distance
+IK_BUDGET = 0.2  # s per IK query (the iteration bound decides first)
+
+
+def resolved_params(task: CheckedTask, arm: str | None = None) -> PickPlaceParams:
+    """The task's pick-place parameters with world positions: as given for ``placement: world``,
+    converted from the robot frame and reach units for ``placement: reach``."""
+    params: PickPlaceParams = task.config.pick_place  # type: ignore[union-attr]
+    if params.placement == "world":
+        return params
+    mount = task.config.robots[0]
+    T = pose_matrix(mount)
+    forward = T[:3, 0].copy()
+    forward[2] = 0.0
+    forward = forward / np.linalg.norm(forward) if np.linalg.norm(forward) > 1e-9 else np.array([1.0, 0.0, 0.0])
+    left = np.array([-forward[1], forward[0], 0.0])
+    reach = arm_reach(task, arm)
+
+    def world(xy) -> list[float]:
+        p = T[:3, 3] + reach * (xy[0] * forward + xy[1] * left)
+        return [float(p[0]), float(p[1])]
+
+    obj = params.object
+    return params.model_copy(update={
+        "placement": "world",
+        "object": obj.model_copy(update={"position": [*world(obj.position), obj.position[2]]}),
+        "place_position": [*world(params.place_position), params.place_position[2]],
+    })
+
+
+def arm_reach(task: CheckedTask, arm: str | None = None) -> float:
+    """The arm's reach (m): the farthest horizontal distance from the base, straight ahead, at
+    which the tool pointing down reaches the object's grasp height and the pre-grasp height."""
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.moves import bound_ik_by_iterations
+    from robocfg.motion.reach import support_height
+
+    params: PickPlaceParams = task.config.pick_place  # type: ignore[union-attr]
+    robot = task.robots[0]
+    arm_cfg = robot.config.arm(arm)
+    T_base = pose_matrix(task.config.robots[0])
+    model = KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=T_base)
+    bound_ik_by_iterations(model)
+    rng = np.random.default_rng(0)
+    q = rng.uniform(model.lower, model.upper, size=(FK_SAMPLES, len(model.lower)))
+    far = max(float(np.linalg.norm(model.fk(qi, "ee")[:2, 3] - T_base[:2, 3])) for qi in q)
+    far += abs(arm_cfg.tcp_offset)
+    forward = T_base[:3, 0].copy()
+    forward[2] = 0.0
+    forward /= max(np.linalg.norm(forward), 1e-9)
+    obj = params.object
+    shape = object_shape(obj, task.path.parent)
+    R0 = quat_to_matrix(obj.quaternion_xyzw())
+    grip = shape.below_origin(R0) + (shape.posed(R0)[:, 2].max() if isinstance(arm_cfg.gripper, SuctionGripperConfig) else 0.0)
+    home = np.asarray(arm_cfg.home, float)
+
+    def reachable(d: float) -> bool:
+        p = T_base[:3, 3] + d * forward
+        z = support_height(task.config.scene, p[0], p[1]) + grip
+        down = np.array([0.0, 0.0, -1.0])
+        for height in (z + params.above_height, z):
+            ok = False
+            for a in (0.5 * math.pi, 0.0):  # fingers closing across, then along, the forward direction
+                closing = math.cos(a) * forward + math.sin(a) * np.array([-forward[1], forward[0], 0.0])
+                g = Grasp(np.array([p[0], p[1], height]), grasp_rotation(down, closing), 0.0)
+                if model.ik(ee_pose_from_grasp(g, arm_cfg), seed_q=home, frame="ee", time_budget=IK_BUDGET).converged:
+                    ok = True
+                    break
+            if not ok:
+                return False
+        return True
+
+    good, bad = None, far
+    for d in np.linspace(far, far / SCAN_STEPS, SCAN_STEPS):
+        if reachable(float(d)):
+            good = float(d)
+            break
+        bad = float(d)
+    if good is None:
+        return 0.0
+    for _ in range(REFINE_STEPS):
+        mid = (good + bad) / 2
+        good, bad = (mid, bad) if reachable(mid) else (good, mid)
+    return good

@@ -1,0 +1,45 @@
+"""Reach is checked against the robot before simulating: validate warns, and run exits 1 naming
+the phase (report written) when the task's object or place spot is out of the arm's reach."""
+
+import json
+
+import yaml
+from _cli import run_main
+
+from robocfg.checks import load_task
+from robocfg.config import catalog
+from robocfg.motion.reach import pick_place_reach
+
+
+def _default_task_on(tmp_path, robot: str):
+    data = yaml.safe_load(catalog.find("tasks", "pick_place").read_text())
+    data["robots"][0]["robot"] = robot
+    path = tmp_path / f"pick_place_{robot}.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_desk_spots_are_out_of_a_kr210s_reach(tmp_path):
+    problems = pick_place_reach(load_task(_default_task_on(tmp_path, "kuka_kr210")))
+    nominal = {(p.phase, p.loc[-1]) for p in problems if p.nominal}
+    assert nominal == {("pre_grasp", "position"), ("transport", "place_position")}
+    assert all(p.residual > 0.1 for p in problems)
+
+
+def test_shipped_pick_place_tasks_are_in_reach():
+    for name in ("pick_place", "pick_place_kuka_kr210", "pick_place_obstacle"):
+        assert pick_place_reach(load_task(catalog.find("tasks", name))) == [], name
+
+
+def test_validate_warns_and_run_fails_before_simulating(tmp_path, capsys, monkeypatch):
+    path = _default_task_on(tmp_path, "kuka_kr210")
+    code, _, err = run_main(["validate", str(path)], capsys, monkeypatch)
+    assert code == 0
+    assert "pick_place.object.position: warning: pre_grasp: the pose above the object is unreachable, out of the arm's reach" in err
+    out_json = tmp_path / "r.json"
+    code, out, err = run_main(["run", "pick-place", str(path), "-n", "2", "-q", "--json", str(out_json)], capsys, monkeypatch)
+    assert code == 1
+    assert "pre_grasp: the pose above the object is unreachable, out of the arm's reach" in out
+    report = json.loads(out_json.read_text())
+    assert [e["failed_phase"] for e in report["episodes"]] == ["pre_grasp", "pre_grasp"]
+    assert all(e["steps"] == 0 for e in report["episodes"])  # nothing was simulated
