@@ -3,7 +3,10 @@ built-in robot and a range of objects (primitives of every shape, 3–9 cm, 0.05
 objects from pybullet_data).
 
     python benchmarks/bench_any_object.py --episodes 20 [--robots panda,xarm6] [--objects cube_5cm,duck]
-                                          [--workers 2] [--json out.json] [--markdown table.md]
+                                          [--task pick_place] [--workers 2] [--json out.json] [--markdown table.md]
+
+``--task pick_place_reach`` runs the same matrix on the task whose spots are fractions of each
+arm's reach (``placement: reach``), where the industrial arms are not rejected as out of reach.
 
 Before simulating, each cell is checked the way ``validate`` and ``run`` check it: the task must
 load (an object wider than the open gripper is an error), a mesh wider than the gripper as a whole
@@ -60,13 +63,14 @@ class Cell:
     wall_s: float = 0.0
 
 
-def task_file(folder: Path, robot: str, name: str) -> Path:
-    """The default pick-place task with its first robot and its object replaced (nothing else)."""
+def task_file(folder: Path, robot: str, name: str, task: str = "pick_place") -> Path:
+    """The pick-place task ``task`` (default: the default one) with its first robot and its object
+    replaced (nothing else)."""
     import yaml
 
     from robocfg.config import catalog
 
-    data = yaml.safe_load(catalog.find("tasks", "pick_place").read_text())
+    data = yaml.safe_load(catalog.find("tasks", task).read_text())
     data["robots"][0]["robot"] = robot
     old = data["pick_place"]["object"]
     data["pick_place"]["object"] = {"name": name, "position": old["position"], "euler_deg": [0.0, 0.0, 0.0],
@@ -76,8 +80,8 @@ def task_file(folder: Path, robot: str, name: str) -> Path:
     return path
 
 
-def run_cell(args: tuple[str, str, int, int, str]) -> Cell:
-    robot, name, episodes, seed, folder = args
+def run_cell(args: tuple[str, str, int, int, str, str]) -> Cell:
+    robot, name, episodes, seed, folder, task_name = args
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
@@ -89,7 +93,7 @@ def run_cell(args: tuple[str, str, int, int, str]) -> Cell:
     cell = Cell(robot, name)
     t0 = time.perf_counter()
     try:
-        task = load_task(task_file(Path(folder), robot, name))
+        task = load_task(task_file(Path(folder), robot, name, task_name))
     except ConfigError as exc:
         cell.rejected = "; ".join(f"{p.path}: {p.message}" for p in exc.problems if p.severity == "error")
         return cell
@@ -114,6 +118,8 @@ def _short(reason: str) -> str:
 
 
 def markdown(cells: list[Cell], robots: list[str], objects: list[str], episodes: int, seed: int) -> str:
+    """The success table (robots × objects), the overall rate over feasible cells, failures by
+    phase, and the rejected cells with their reasons."""
     by = {(c.robot, c.object): c for c in cells}
     lines = ["| robot | " + " | ".join(objects) + " |", "|---|" + "---|" * len(objects)]
     for r in robots:
@@ -141,6 +147,7 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--robots", default=None, help="comma-separated robot names (default: every built-in)")
     ap.add_argument("--objects", default=None, help=f"comma-separated, from: {', '.join(OBJECTS)}")
+    ap.add_argument("--task", default="pick_place", help="a pick_place task whose object is replaced")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--json", default=None)
     ap.add_argument("--markdown", default=None)
@@ -154,7 +161,7 @@ def main() -> None:
     objects = args.objects.split(",") if args.objects else list(OBJECTS)
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as folder:
-        jobs = [(r, o, args.episodes, args.seed, folder) for r in robots for o in objects]
+        jobs = [(r, o, args.episodes, args.seed, folder, args.task) for r in robots for o in objects]
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             cells = []
             for cell in pool.map(run_cell, jobs):

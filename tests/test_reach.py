@@ -43,3 +43,15 @@ def test_validate_warns_and_run_fails_before_simulating(tmp_path, capsys, monkey
     report = json.loads(out_json.read_text())
     assert [e["failed_phase"] for e in report["episodes"]] == ["pre_grasp", "pre_grasp"]
     assert all(e["steps"] == 0 for e in report["episodes"])  # nothing was simulated
+
+
+def test_support_is_the_fixture_below_the_spot():
+    """The cell task's panel lies on a 1.91 m fixture: the reach check asks for poses above it, not
+    above the ground (which no arm on the 2.51 m pedestal could reach)."""
+    from robocfg.motion.reach import support_height
+
+    task = load_task(catalog.find("tasks", "pick_place_cell"))
+    obj = task.config.pick_place.object
+    assert abs(support_height(task.config.scene, obj.position[0], obj.position[1]) - 1.91) < 1e-6
+    assert support_height(task.config.scene, 3.0, 3.0) == 0.0
+    assert pick_place_reach(task) == []

@@ -90,6 +90,24 @@ class ObjectShape:
         proj = xy @ np.stack([np.cos(a), np.sin(a)])
         return float((proj.max(axis=0) - proj.min(axis=0)).min())
 
+    def top_at(self, R: np.ndarray, position, x: float, y: float) -> float | None:
+        """Height (m, world) of the body's top surface above the point (x, y) when it stands at
+        ``position`` turned by ``R``; None when no part of it is above or below that point. Exact
+        for the convex parts: the vertical line is clipped by every face plane."""
+        best = None
+        for part in self.parts:
+            n = np.asarray(part.face_normals) @ np.asarray(R, float).T
+            v = np.asarray(part.triangles[:, 0]) @ np.asarray(R, float).T + np.asarray(position, float)
+            rhs = np.einsum("ij,ij->i", n, v) - n[:, 0] * x - n[:, 1] * y  # n_z z <= rhs on every face
+            up, down, side = n[:, 2] > 1e-9, n[:, 2] < -1e-9, np.abs(n[:, 2]) <= 1e-9
+            if np.any(rhs[side] < -1e-9) or not np.any(up):
+                continue
+            top = float(np.min(rhs[up] / n[up, 2]))
+            bottom = float(np.max(rhs[down] / n[down, 2])) if np.any(down) else -np.inf
+            if bottom <= top + 1e-9:
+                best = top if best is None else max(best, top)
+        return best
+
     def surface(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """``count`` points spread over the parts' surfaces (area-weighted) and their outward unit
         normals, body frame: the object's own point cloud, no camera needed."""

@@ -83,7 +83,7 @@ def arm_reach(task: CheckedTask, arm: str | None = None) -> float:
 
     def reachable(d: float) -> bool:
         p = T_base[:3, 3] + d * forward
-        z = support_height(task.config.scene, p[0], p[1]) + grip
+        z = support_height(task.config.scene, p[0], p[1], task.path.parent) + grip
         down = np.array([0.0, 0.0, -1.0])
         for height in (z + params.above_height, z):
             ok = False

@@ -4,9 +4,9 @@ For the object's spot and the place spot (their nominal points and the corners o
 randomisation regions) the tool pointing straight down is asked for at the grasp height and at
 the pre-grasp / carrying height above it, turned about the vertical in ``YAW_STEPS`` steps (any
 turn that IK reaches will do). Heights come from the object's real geometry resting on the support
-below the spot (the table top where the spot is over the table, else the ground). A nominal point
-out of reach fails the run before it starts (the phase that would fail is named); a region corner
-out of reach is a warning (some randomised episodes would fail).
+below the spot (the highest static surface there: table, pedestal, fixture, obstacle, else the
+ground). A nominal point out of reach fails the run before it starts (the phase that would fail
+is named); a region corner out of reach is a warning (some randomised episodes would fail).
 
 Frames: world, metres.
 """
@@ -16,10 +16,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from itertools import product
+from pathlib import Path
 
 import numpy as np
 
 from robocfg.assets.object_shape import object_shape
+from robocfg.assets.paths import UnresolvedPath
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import PickPlaceParams
 from robocfg.config.robot import SuctionGripperConfig
@@ -94,7 +96,7 @@ def pick_place_reach(task: CheckedTask, arm: str | None = None, params: PickPlac
             if not nominal and (not any(rng) or (out and out[-1].loc == loc)):
                 break  # no region, or the nominal point already fails: corners add nothing
             x, y = xy0[0] + sx * rng[0], xy0[1] + sy * rng[1]
-            z = support_height(scene, x, y) + grip_above_support
+            z = support_height(scene, x, y, task.path.parent) + grip_above_support
             for phase, what, height in ((high_phase, high_what, z + rise), (low_phase, low_what, z)):
                 residual = _best_residual(model, arm_cfg, home, np.array([x, y, height]))
                 if residual is not None:
@@ -118,13 +120,28 @@ def _best_residual(model, arm_cfg, home: np.ndarray, point: np.ndarray) -> float
     return best
 
 
-def support_height(scene: Scene, x: float, y: float) -> float:
-    """Height (m) of the surface at (x, y): the table top where the point is over it, else the
-    ground (0) — or the table top when there is no ground."""
+def support_height(scene: Scene, x: float, y: float, base_dir: Path | None = None) -> float:
+    """Height (m) of the highest static surface at (x, y): the table, the pedestal, static scene
+    objects (mass 0, fixtures) and obstacles, else the ground (0)."""
+    from robocfg.config.scene import Body
+
+    statics: list[Body] = [*(o for o in scene.objects if o.mass == 0), *scene.obstacles]
     t = scene.table
     if t is not None:
-        R = quat_to_matrix(t.quaternion_xyzw())
-        local = R.T @ (np.array([x, y, t.position[2]]) - np.asarray(t.position))
-        if abs(local[0]) <= t.size[0] / 2 and abs(local[1]) <= t.size[1] / 2:
-            return float(t.position[2])
-    return 0.0
+        statics.append(Body(name="table", shape="box", size=list(t.size), quat_xyzw=list(t.quaternion_xyzw()),
+                            position=[t.position[0], t.position[1], t.position[2] - t.size[2] / 2]))
+    ped = scene.pedestal
+    if ped is not None:
+        statics.append(Body(name="pedestal", shape="cylinder", size=[ped.radius, ped.height],
+                            quat_xyzw=list(ped.quaternion_xyzw()),
+                            position=[ped.position[0], ped.position[1], ped.position[2] - ped.height / 2]))
+    z = 0.0
+    for body in statics:
+        try:
+            shape = object_shape(body, base_dir or Path("."))
+        except (UnresolvedPath, ValueError):
+            continue  # a missing mesh is reported by the task checks
+        top = shape.top_at(quat_to_matrix(body.quaternion_xyzw()), body.position, x, y)
+        if top is not None:
+            z = max(z, top)
+    return z

@@ -273,8 +273,15 @@ class _StateMachine:
         if self.boxes is None:
             return "no grasp found"
         narrow = lying.shape.min_horizontal_width(lying.rotation)
-        return (f"no grasp found: the object ({narrow * 1000:.1f} mm across its narrowest horizontal side) "
-                f"does not fit the open fingers ({usable_width(self.boxes) * 1000:.1f} mm usable)")
+        usable = usable_width(self.boxes)
+        if narrow > usable:
+            return (f"no grasp found: the object ({narrow * 1000:.1f} mm across its narrowest horizontal side) "
+                    f"does not fit the open fingers ({usable * 1000:.1f} mm usable)")
+        sweep = self.boxes.closing_sweep(narrow)
+        tip = float(sweep.hi[sweep.finger, 0].max())
+        return (f"no grasp height: closing to {narrow * 1000:.1f} mm the fingertips reach {tip * 1000:.0f} mm past the "
+                f"TCP, so with them above the support and the palm above the object's top the pads cannot reach the "
+                f"object ({(lying.top_z - lying.bottom_z) * 1000:.0f} mm tall)")
 
     def _rest_on_support(self) -> np.ndarray:
         """Put the object on the surface below it (its lowest point on the support, whatever its
