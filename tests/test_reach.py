@@ -27,8 +27,12 @@ def test_desk_spots_are_out_of_a_kr210s_reach(tmp_path):
 
 
 def test_shipped_pick_place_tasks_are_in_reach():
-    for name in ("pick_place", "pick_place_kuka_kr210", "pick_place_obstacle"):
-        assert pick_place_reach(load_task(catalog.find("tasks", name))) == [], name
+    """Every built-in pick-place task (bins, fixtures, pedestals, tables included) is in reach."""
+    tasks = [load_task(path) for path in catalog.available("tasks").values()]
+    pick_place = [t for t in tasks if t.config.task == "pick_place"]
+    assert len(pick_place) >= 4
+    for task in pick_place:
+        assert pick_place_reach(task) == [], task.path.name
 
 
 def test_validate_warns_and_run_fails_before_simulating(tmp_path, capsys, monkeypatch):

@@ -122,10 +122,10 @@ def _best_residual(model, arm_cfg, home: np.ndarray, point: np.ndarray) -> float
 
 def support_height(scene: Scene, x: float, y: float, base_dir: Path | None = None) -> float:
     """Height (m) of the highest static surface at (x, y): the table, the pedestal, static scene
-    objects (mass 0, fixtures) and obstacles, else the ground (0)."""
+    objects (mass 0), obstacles and fixture parts (a bin's floor, a shelf's level), else the ground (0)."""
     from robocfg.config.scene import Body
 
-    statics: list[Body] = [*(o for o in scene.objects if o.mass == 0), *scene.obstacles]
+    statics: list[Body] = [*(o for o in scene.objects if o.mass == 0), *scene.obstacles, *scene.fixture_parts()]
     t = scene.table
     if t is not None:
         statics.append(Body(name="table", shape="box", size=list(t.size), quat_xyzw=list(t.quaternion_xyzw()),
