@@ -44,7 +44,7 @@ def test_tall_cylinder_is_gripped_near_its_top(tmp_path):
     higher, yet below the top by at least the minimum grip depth."""
     from robocfg.assets.object_shape import object_shape
     from robocfg.grasp.gripper_model import measure_gripper
-    from robocfg.grasp.object_grasp import MIN_GRIP_DEPTH, LyingObject, top_down_groups
+    from robocfg.grasp.object_grasp import MIN_GRIP_DEPTH, PAD_REACH, LyingObject, top_down_groups
     from robocfg.sim.world import World
 
     task = _task(tmp_path, "panda", OBJECTS["tall_cylinder"])
@@ -55,4 +55,4 @@ def test_tall_cylinder_is_gripped_near_its_top(tmp_path):
     lying = LyingObject(object_shape(obj, task.path.parent), np.array([0.5, -0.15, 0.045]), np.eye(3), 0.0)
     groups = top_down_groups(lying, boxes)
     z = groups[0][0].center[2]
-    assert 0.045 + 0.01 < z <= 0.09 - MIN_GRIP_DEPTH + 1e-9
+    assert 0.045 + 0.01 < z <= 0.09 - MIN_GRIP_DEPTH + PAD_REACH + 1e-9

@@ -34,7 +34,8 @@ PALM_MARGIN = 0.006  # m: non-finger links kept this far above the object's top
 LINKAGE_MARGIN = 0.001  # m: clearance kept between the object and the gripper's non-finger links
 HEIGHT_STEP = 0.002  # m: grasp heights tried from mid-height upwards
 GROUND_MARGIN = 0.004  # m: fingertips kept this far above the support
-MIN_GRIP_DEPTH = 0.008  # m: the TCP at least this far below the top (the pads must overlap the object)
+MIN_GRIP_DEPTH = 0.008  # m: the pads' lower part reaches at least this far below the object's top
+PAD_REACH = 0.01  # m: how far below the TCP the pads count as gripping (half a 2 cm pad), at most their tip
 DIRECTIONS = 12  # closing directions tried over half a turn (plus the body's own x and y axes)
 SAME_WIDTH = 0.001  # m: widths closer than this count as equal when ordering directions
 SURFACE_CHECK_POINTS = 400  # object points the top-down grasp height is checked with
@@ -114,14 +115,15 @@ def _grasp_height(obj: LyingObject, boxes: GripperBoxes, closing: np.ndarray, wi
     or, where the palm or a linkage would touch the object there (checked on the gripper's
     oriented link boxes at every measured opening down to ``width``, the object raised by
     ``PALM_MARGIN`` too), the lowest height in ``HEIGHT_STEP`` steps where nothing does; the
-    fingertips stay ``GROUND_MARGIN`` above the support. None when no height down to
-    ``MIN_GRIP_DEPTH`` below the top is clear. In the grasp frame x points down."""
+    fingertips stay ``GROUND_MARGIN`` above the support. None when no clear height leaves the
+    pads (down to ``PAD_REACH`` below the TCP, at most to the tip) ``MIN_GRIP_DEPTH`` below the
+    object's top. In the grasp frame x points down."""
     R = grasp_rotation(np.array([0.0, 0.0, -1.0]), closing)
     sweep = boxes.closing_sweep(width)
     tip = float(sweep.hi[sweep.finger, 0].max())
     top, bottom = obj.top_z, obj.bottom_z
     lowest = max((top + bottom) / 2, obj.support_z + GROUND_MARGIN + tip)
-    highest = top - min(MIN_GRIP_DEPTH, (top - bottom) / 2)
+    highest = top - min(MIN_GRIP_DEPTH, (top - bottom) / 2) + min(tip, PAD_REACH)
     P = obj.surface_points()
     P = np.concatenate([P, P + np.array([0.0, 0.0, PALM_MARGIN])])
     centre_xy = obj.position[:2]
