@@ -43,7 +43,7 @@ def renderer_rates(renderers: list[str], frames: int) -> list[dict]:
     quiet_import()
     from robocfg.checks import load_task
     from robocfg.config import catalog
-    from robocfg.sim.record import render, scene_camera, view_projection
+    from robocfg.sim.record_camera import render, scene_camera, view_projection
     from robocfg.sim.render_mirror import RenderMirror
     from robocfg.sim.world import World
 

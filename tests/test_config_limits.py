@@ -57,7 +57,7 @@ def test_size_limit():
 
 def test_exponent_floats_and_no_booleans_as_numbers():
     from robocfg.config.commands import GripperParams
-    from robocfg.config.load import validate_document
+    from robocfg.config.validation import validate_document
 
     doc = parse_yaml("rate: 5e-1\nhold_time: 2E0\n", Path("g.yaml"))
     assert validate_document(doc, GripperParams).rate == 0.5

@@ -6,9 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from robocfg.config.load import detect_kind, format_loc, load_yaml, parse_yaml, validate_document
+from robocfg.config.load import detect_kind, format_loc, load_yaml, parse_yaml
 from robocfg.config.robot import RobotConfig
 from robocfg.config.task import TaskConfig
+from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -7,7 +7,7 @@ from robocfg.checks import load_task
 from robocfg.config import catalog
 from robocfg.grasp.draw import BEST, OTHER, GraspRecorder, grasp_polylines
 from robocfg.kinematics.frames import Grasp
-from robocfg.sim.record import CameraView
+from robocfg.sim.record_camera import CameraView
 from robocfg.sim.world import World
 
 CAM = CameraView(target=(0.5, 0.0, 0.1), distance=0.8, yaw_deg=50.0, pitch_deg=-30.0)

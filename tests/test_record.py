@@ -9,7 +9,8 @@ from PIL import Image
 
 from robocfg.checks import load_task
 from robocfg.config import catalog
-from robocfg.sim.record import Recorder, scene_camera
+from robocfg.sim.record import Recorder
+from robocfg.sim.record_camera import scene_camera
 from robocfg.sim.record_overlay import FAIL_COLOR
 from robocfg.sim.world import World
 

@@ -9,7 +9,7 @@ from PIL import Image
 from robocfg.checks import load_robot
 from robocfg.config import catalog
 from robocfg.config.types import AXIS_INDEX
-from robocfg.sim.record import fit_camera, project
+from robocfg.sim.record_camera import fit_camera, project
 from robocfg.sim.still_scene import StillScene
 from robocfg.viewer.overlay import AXIS_COLORS, PAD_COLOR
 from robocfg.viewer.sheet import PANEL, scene_frames

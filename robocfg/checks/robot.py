@@ -21,7 +21,7 @@ from robocfg.assets.fingers import (
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass, parse_urdf
 from robocfg.checks.tool_point import check_one_jaw, check_suction
-from robocfg.config.load import Loc, YamlDocument, load_yaml, validate_document
+from robocfg.config.load import Loc, YamlDocument, load_yaml
 from robocfg.config.robot import (
     ArmConfig,
     OneJawGripperConfig,
@@ -30,6 +30,7 @@ from robocfg.config.robot import (
     SuctionGripperConfig,
 )
 from robocfg.config.types import AXIS_INDEX
+from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError, Problem
 from robocfg.suggest import did_you_mean
 

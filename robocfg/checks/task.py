@@ -16,7 +16,7 @@ from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.scene import check_scene
 from robocfg.checks.task_params import check_task_params
 from robocfg.config import catalog
-from robocfg.config.load import YamlDocument, load_yaml, validate_document
+from robocfg.config.load import YamlDocument, load_yaml
 from robocfg.config.overrides import (
     ROBOT_OVERRIDE_SOURCE,
     apply_overrides,
@@ -24,6 +24,7 @@ from robocfg.config.overrides import (
     parse_key,
 )
 from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
+from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError, NotFound, Problem
 from robocfg.suggest import did_you_mean
 

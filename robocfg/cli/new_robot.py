@@ -71,8 +71,9 @@ def _draft(source: Path, name: str, out_dir: Path):
     from robocfg.assets.draft import draft_composed, draft_robot
     from robocfg.assets.paths import UnresolvedPath
     from robocfg.assets.urdf import UrdfParseError, parse_urdf
-    from robocfg.config.load import load_yaml, validate_document
+    from robocfg.config.load import load_yaml
     from robocfg.config.robot import RobotSource
+    from robocfg.config.validation import validate_document
     from robocfg.errors import ConfigError, Problem, RobocfgError
 
     try:

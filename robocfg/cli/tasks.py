@@ -44,8 +44,9 @@ def tasks(json_path: JsonOpt = None) -> None:
 
 
 def _entry(name: str, path) -> TaskEntry:
-    from robocfg.config.load import load_yaml, validate_document
+    from robocfg.config.load import load_yaml
     from robocfg.config.task import TaskConfig
+    from robocfg.config.validation import validate_document
     from robocfg.errors import ConfigError
 
     try:

@@ -160,7 +160,8 @@ class RobotEnv(gym.Env):
         if self.render_mode != "rgb_array":
             return None
         if self._renderer is None:
-            from robocfg.sim.record import CameraView, Recorder
+            from robocfg.sim.record import Recorder
+            from robocfg.sim.record_camera import CameraView
 
             c = self.workspace.center
             cam = CameraView(target=(float(c[0]), float(c[1]), 0.15), distance=1.0 + 4 * self.workspace.half)

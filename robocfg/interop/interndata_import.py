@@ -26,16 +26,9 @@ from robocfg.assets.draft_gripper import UnsupportedGripper, parallel_gripper
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass, parse_urdf
 from robocfg.checks import CheckedRobot, load_robot
-from robocfg.config.load import (
-    _MISSING,
-    Loc,
-    YamlDocument,
-    _lookup,
-    format_loc,
-    load_yaml,
-    validate_document,
-)
+from robocfg.config.load import Loc, YamlDocument, format_loc, load_yaml
 from robocfg.config.robot import Attachment
+from robocfg.config.validation import _MISSING, _lookup, validate_document
 from robocfg.errors import ConfigError, Problem
 from robocfg.interop.extension import BLOCK_KEY, overlay, rebase_paths
 from robocfg.interop.interndata_map import Dropped, Mapped, map_interndata

@@ -63,7 +63,8 @@ class FollowLoop:
         self.sliders = _Sliders(world, target.position(0.0)) if options.gui else None
         self.recorder = None
         if options.record is not None:
-            from robocfg.sim.record import CameraView, Recorder
+            from robocfg.sim.record import Recorder
+            from robocfg.sim.record_camera import CameraView
 
             c = target.center
             view = CameraView(target=(float(c[0]) * 0.6, float(c[1]), float(c[2]) * 0.8), distance=1.5,

@@ -85,7 +85,7 @@ class GraspSession(EpisodeSession[GraspEpisode]):
 
     def make_recorder(self, path: Any) -> FrameRecorder:
         from robocfg.grasp.draw import GraspRecorder
-        from robocfg.sim.record import CameraView
+        from robocfg.sim.record_camera import CameraView
 
         view = CameraView(target=(0.5, 0.0, 0.08), distance=0.7, yaw_deg=50.0, pitch_deg=-30.0)
         return GraspRecorder(self.world, path, fps=12.0, camera=view, settings=self.options.recording)

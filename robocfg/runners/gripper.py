@@ -120,7 +120,8 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
     """Run the gripper task; returns the result or raises RunFailed carrying it. ``should_stop``
     (SIGINT) ends the run early with the result marked ``interrupted``; ``recording``: the user's
     RecordSettings for ``record``."""
-    from robocfg.sim.record import Recorder, facing_camera
+    from robocfg.sim.record import Recorder
+    from robocfg.sim.record_camera import facing_camera
     from robocfg.sim.world import World
 
     params: GripperParams = task.config.gripper  # type: ignore[union-attr]

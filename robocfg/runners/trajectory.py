@@ -249,7 +249,8 @@ def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = N
 
 def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps, should_stop, recording=None) -> None:
     from robocfg.motion.follower import follow
-    from robocfg.sim.record import CameraView, Recorder
+    from robocfg.sim.record import Recorder
+    from robocfg.sim.record_camera import CameraView
     from robocfg.sim.world import World
 
     with World(task, gui=gui) as world:

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from PIL import Image, ImageDraw
 
-from robocfg.sim.record import CameraView, facing_camera, fit_camera, project, render
+from robocfg.sim.record_camera import CameraView, facing_camera, fit_camera, project, render
 from robocfg.sim.still_scene import StillScene
 from robocfg.viewer.frames import ArmFrames, arm_frames, box_corners, pad_boxes_ee
 from robocfg.viewer.overlay import (
