@@ -31,7 +31,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from robocfg.sim.render_mirror import MAX_FACES
+from robocfg.sim.low_poly import MAX_FACES
 
 SIZES = ((160, 120), (240, 180), (320, 240), (480, 360), (640, 480))
 FACES = {"full": None, "tiny": MAX_FACES, "tiny500": 500, "egl": MAX_FACES}

@@ -11,9 +11,10 @@ import pytest
 from robocfg.checks import load_task
 from robocfg.config import catalog
 from robocfg.config.scene import Body
+from robocfg.sim.low_poly import low_poly
 from robocfg.sim.record import Recorder
 from robocfg.sim.record_camera import render, scene_camera, view_projection
-from robocfg.sim.render_mirror import RenderMirror, low_poly
+from robocfg.sim.render_mirror import RenderMirror
 from robocfg.sim.world import World
 
 SIZE = (240, 180)

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robocfg.errors import RobocfgError
+from robocfg.sim.low_poly import MAX_FACES
 from robocfg.sim.record_camera import (
     CameraView,
     project,
@@ -27,7 +28,7 @@ from robocfg.sim.record_camera import (
 )
 from robocfg.sim.record_overlay import FrameInfo, Marker, contact_sheet, draw_markers, draw_status
 from robocfg.sim.record_settings import RecordSettings
-from robocfg.sim.render_mirror import MAX_FACES, RenderMirror
+from robocfg.sim.render_mirror import RenderMirror
 
 if TYPE_CHECKING:
     from robocfg.sim.world import World
