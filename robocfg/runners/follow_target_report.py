@@ -7,7 +7,7 @@ Units are in the field names (``_mm``, ``_deg``, ``_ms``) or next to the field; 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +15,7 @@ import numpy as np
 
 from robocfg.config.commands import FollowTargetParams
 from robocfg.engine.runner import ReportView
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, SingleRunReport
 
 SAMPLE_RATE = 60.0  # Hz of the samples kept in the result
 FINAL_WINDOW = 0.25  # s averaged for the final (residual) error
@@ -38,7 +38,7 @@ class Stats:
 
 
 @dataclass
-class FollowTargetResult:
+class FollowTargetResult(SingleRunReport):
     schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
     task: str
     robot: str
@@ -84,17 +84,6 @@ class FollowTargetResult:
     plot: str | None = None
     interrupted: bool = False  # stopped by SIGINT/SIGTERM: statistics over the steps run until then
 
-    def to_dict(self) -> dict:
-        return asdict(self)
-
-    def passed(self, min_success: float) -> bool:
-        return self.success
-
-    def failure_lines(self) -> list[str]:
-        return []
-
-    def episodes_finished(self) -> int:
-        return 0 if self.interrupted else 1
 
     def summary_line(self, timing: object = None) -> str:
         if not self.success:

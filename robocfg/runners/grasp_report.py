@@ -9,7 +9,7 @@ import numpy as np
 
 from robocfg.engine.runner import EpisodesReport, ReportView
 from robocfg.engine.session import BatchTiming
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, failed_episodes_line
 
 
 @dataclass
@@ -100,8 +100,7 @@ class GraspReport(EpisodesReport):
                      ("attempts", str(len(e.attempts)))]
         footer = []
         if failed:
-            footer.append(f"failed episodes: {', '.join(f'{e.index} ({e.object})' for e in failed[:20])}"
-                          f"{' ...' if len(failed) > 20 else ''} (seeds and details in --json)")
+            footer.append(failed_episodes_line([f"{e.index} ({e.object})" for e in failed]))
         return ReportView(f"run grasp: {self.robot} (arm {self.arm}), seed {self.seed}", rows,
                           warnings=list(self.warnings), failures=self.failure_lines(), footer=footer,
                           status="failed" if failed else "ok")

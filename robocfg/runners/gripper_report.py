@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 from robocfg.engine.runner import ReportView, TableView
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, SingleRunReport
 
 
 @dataclass
@@ -35,7 +35,7 @@ class HoldTest:
 
 
 @dataclass
-class GripperResult:
+class GripperResult(SingleRunReport):
     schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
     task: str
     robot: str
@@ -64,17 +64,6 @@ class GripperResult:
     record: str | None = None
     interrupted: bool = False  # stopped by SIGINT/SIGTERM: the result holds what was measured until then
 
-    def to_dict(self) -> dict:
-        return asdict(self)
-
-    def passed(self, min_success: float) -> bool:
-        return self.success
-
-    def failure_lines(self) -> list[str]:
-        return []  # the one failure is in the summary line
-
-    def episodes_finished(self) -> int:
-        return 0 if self.interrupted else 1
 
     def summary_line(self, timing: object = None) -> str:
         if not self.success:

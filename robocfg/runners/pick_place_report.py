@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 from robocfg.engine.runner import EpisodesReport, ReportView
 from robocfg.engine.session import BatchTiming
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, failed_episodes_line
 
 PHASES = ("pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
 
@@ -89,8 +89,7 @@ class PickPlaceReport(EpisodesReport):
             rows += [("place error", f"{(e.place_error or 0.0) * 100:.2f} cm"), ("tilt", f"{e.tilt_deg or 0.0:.1f}°")]
         footer = []
         if failed:
-            footer.append(f"failed episodes: {', '.join(str(e.index) for e in failed[:20])}"
-                          f"{' ...' if len(failed) > 20 else ''} (seeds and details in --json)")
+            footer.append(failed_episodes_line([str(e.index) for e in failed]))
         return ReportView(f"run pick-place: {self.robot} (arm {self.arm}), seed {self.seed}", rows,
                           warnings=list(self.warnings), failures=self.failure_lines(), footer=footer,
                           status="failed" if failed else "ok")

@@ -28,3 +28,32 @@ class FailedRunReport:
     reason: str
     success: bool = False
     schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)
+
+
+class SingleRunReport:
+    """The report protocol's answers shared by the one-run kinds (gripper, trajectory,
+    follow-target): a dataclass with ``success`` and ``interrupted`` whose one failure, if any,
+    is told by its summary line."""
+
+    success: bool
+    interrupted: bool
+
+    def to_dict(self) -> dict:
+        from dataclasses import asdict
+
+        return asdict(self)  # type: ignore[call-overload]
+
+    def passed(self, min_success: float) -> bool:
+        return self.success
+
+    def failure_lines(self) -> list[str]:
+        return []
+
+    def episodes_finished(self) -> int:
+        return 0 if self.interrupted else 1
+
+
+def failed_episodes_line(labels: list[str], shown: int = 20) -> str:
+    """``failed episodes: 3, 7 (cube), ...`` for a batch report's footer (first ``shown`` labels)."""
+    more = " ..." if len(labels) > shown else ""
+    return f"failed episodes: {', '.join(labels[:shown])}{more} (seeds and details in --json)"

@@ -22,7 +22,7 @@ from robocfg.engine.options import option
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import ReportView, RunOutput, TableView, TaskRunner
 from robocfg.errors import ConfigError, Problem, RunFailed, RunInterrupted
-from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION
+from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, SingleRunReport
 
 CHECK_RATE = 1000.0  # Hz: resampling rate of the limit check
 
@@ -39,7 +39,7 @@ class Samples:
 
 
 @dataclass
-class TrajectoryResult:
+class TrajectoryResult(SingleRunReport):
     schema_version: int = field(default=REPORT_SCHEMA_VERSION, kw_only=True)  # of the --json report
     task: str
     robot: str
@@ -70,17 +70,6 @@ class TrajectoryResult:
     plot: str | None = None
     interrupted: bool = False  # stopped by SIGINT/SIGTERM while following
 
-    def to_dict(self) -> dict:
-        return asdict(self)
-
-    def passed(self, min_success: float) -> bool:
-        return self.success
-
-    def failure_lines(self) -> list[str]:
-        return []
-
-    def episodes_finished(self) -> int:
-        return 0 if self.interrupted else 1
 
     def summary_line(self, timing: object = None) -> str:
         tr = self.tracking
