@@ -70,12 +70,14 @@ def ik(
 
     from robocfg.checks import load_robot
     from robocfg.config import catalog
+    from robocfg.engine.runner import check_arm_option
     from robocfg.errors import RunFailed
     from robocfg.kinematics.model import KinematicModel
 
     T = _target(position, euler_deg, quat_xyzw)
     position_only = euler_deg is None and quat_xyzw is None
     checked = load_robot(catalog.find("robots", robot))
+    check_arm_option(checked.config, arm)
     model = KinematicModel.from_robot(checked, arm=arm)
     seed = _parse_floats(seed_q, "--seed-q")
     res = model.ik(T, seed_q=seed, frame=frame, backend=backend, time_budget=budget_ms / 1000.0,

@@ -20,6 +20,7 @@ from robocfg.engine.options import EpisodeOutcome, RunOptions
 
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
+    from robocfg.config.robot import RobotConfig
 
 
 @dataclass
@@ -109,6 +110,23 @@ class EpisodesReport:
                           failures=self.failure_lines(), status="ok" if ok == n else "failed")
 
 
+def check_arm_option(robot: RobotConfig, arm: str | None) -> None:
+    """``--arm NAME`` must name an arm of ``robot``: else ``ConfigError`` reading
+    ``--arm NAME: robot 'r' has no arm 'NAME'; did you mean 'right'? (its arms: left, right)``."""
+    from robocfg.errors import ConfigError, Problem
+    from robocfg.suggest import did_you_mean
+
+    names = [a.name for a in robot.arms]
+    if arm is None or arm in names:
+        return
+    if len(names) == 1:
+        message = (f"robot {robot.name!r} has one arm, {names[0]!r}: leave --arm out or give --arm {names[0]}")
+    else:
+        message = (f"robot {robot.name!r} has no arm {arm!r}{did_you_mean(arm, names)} "
+                   f"(its arms: {', '.join(names)})")
+    raise ConfigError([Problem(f"--arm {arm}", None, None, "", message)])
+
+
 class TaskRunner(ABC):
     """Base of every task kind's runner; subclasses set the class attributes and ``run``."""
 
@@ -134,7 +152,7 @@ class TaskRunner(ABC):
         ``NotFound`` or ``RobocfgError``). The default checks the arm name and the episode count."""
         from robocfg.errors import ConfigError, Problem
 
-        self.task.robots[0].config.arm(self.options.arm)  # unknown arm → NotFound with did-you-mean
+        check_arm_option(self.task.robots[0].config, self.options.arm)
         if not self.episodic and self.options.episodes != 1:
             raise ConfigError([Problem("--episodes", None, None, "",
                                        f"'run {self.kind}' runs one episode (it has nothing to randomise), "
