@@ -75,7 +75,8 @@ class CheckedRobot:
 
 class _Collector:
     def __init__(self, doc: YamlDocument):
-        self.doc, self.problems = doc, []
+        self.doc = doc
+        self.problems: list[Problem] = []
 
     def error(self, loc: Loc, msg: str) -> None:
         self.problems.append(self.doc.problem(loc, msg))
@@ -165,7 +166,8 @@ def _compose(doc: YamlDocument, config: RobotConfig, resolver: Resolver, base: P
         except UnresolvedPath as exc:
             problems.append(doc.problem(("attachments", i, "urdf"), f"URDF not found: {exc}"))
             continue
-        parts.append((i, Part(path, a.mount_link, tuple(a.mount_xyz), rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix)))
+        x, y, z = a.mount_xyz
+        parts.append((i, Part(path, a.mount_link, (x, y, z), rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix)))
     if problems:
         raise ConfigError(problems)
     try:

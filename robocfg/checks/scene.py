@@ -9,11 +9,12 @@ errors located at the offending entry (``scene.objects[2].position``), naming bo
 from __future__ import annotations
 
 import itertools
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from robocfg.config.load import YamlDocument
+from robocfg.config.load import Loc, YamlDocument
 from robocfg.config.scene import Body, Scene
 from robocfg.errors import Problem
 
@@ -23,7 +24,7 @@ TOLERANCE = 0.001  # m: resting contact (a cube on a bin floor) is not an overla
 @dataclass(frozen=True)
 class _Box:
     name: str
-    loc: tuple
+    loc: Loc
     R: np.ndarray  # world_R_box
     c: np.ndarray  # centre (m, world)
     h: np.ndarray  # half extents (m)
@@ -68,10 +69,10 @@ def overlap_depth(a: _Box, b: _Box) -> float:
     return depth
 
 
-def check_scene(doc: YamlDocument, scene: Scene, extra: list[tuple[tuple, Body]] = ()) -> list[Problem]:
+def check_scene(doc: YamlDocument, scene: Scene, extra: Sequence[tuple[Loc, Body]] = ()) -> list[Problem]:
     """Problems of ``scene`` (and of ``extra`` (location, body) pairs such as a task's object)."""
     problems: list[Problem] = []
-    names: dict[str, tuple] = {}
+    names: dict[str, Loc] = {}
     movable = [(("scene", "objects", k), b) for k, b in enumerate(scene.objects)] + list(extra)
     for loc, b in [*movable, *((("scene", "obstacles", k), b) for k, b in enumerate(scene.obstacles))]:
         names.setdefault(b.name, loc)
@@ -83,18 +84,18 @@ def check_scene(doc: YamlDocument, scene: Scene, extra: list[tuple[tuple, Body]]
         names.setdefault(f.name, loc)
     parts = [[_box(p, ("scene", "fixtures", k, "position")) for p in f.parts()] for k, f in enumerate(scene.fixtures)]
     for fa, fb in itertools.combinations(parts, 2):
-        hit = _deepest(fa, fb)
-        if hit is not None:
-            a, b, depth = hit
-            problems.append(doc.problem(b.loc, f"fixture part {b.name!r} overlaps fixture part {a.name!r} by {depth * 1000:.1f} mm"))
+        overlap = _deepest(fa, fb)
+        if overlap is not None:
+            pa, pb, depth = overlap
+            problems.append(doc.problem(pb.loc, f"fixture part {pb.name!r} overlaps fixture part {pa.name!r} by {depth * 1000:.1f} mm"))
     fixture_boxes = [p for ps in parts for p in ps]
     things = [(loc, b, "object") for loc, b in movable] + \
              [(("scene", "obstacles", k), b, "obstacle") for k, b in enumerate(scene.obstacles)]
     for loc, body, what in things:
-        hit = _deepest([_box(body, (*loc, "position"))], fixture_boxes)
-        if hit is not None:
-            a, b, depth = hit
-            problems.append(doc.problem(a.loc, f"{what} {body.name!r} is inside fixture part {b.name!r} "
+        inside = _deepest([_box(body, (*loc, "position"))], fixture_boxes)
+        if inside is not None:
+            box, part, depth = inside
+            problems.append(doc.problem(box.loc, f"{what} {body.name!r} is inside fixture part {part.name!r} "
                                                f"(overlap {depth * 1000:.1f} mm)"))
     return problems
 

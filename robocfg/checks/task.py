@@ -23,15 +23,15 @@ from robocfg.config.overrides import (
     blame_overrides,
     parse_key,
 )
-from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskConfig, task_union
+from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskBase, TaskConfig, task_union
 from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError, NotFound, Problem
 from robocfg.suggest import did_you_mean
 
-_TASK_ADAPTER: tuple[tuple[str, ...], TypeAdapter] | None = None
+_TASK_ADAPTER: tuple[tuple[str, ...], TypeAdapter[TaskBase]] | None = None
 
 
-def task_adapter() -> TypeAdapter:
+def task_adapter() -> TypeAdapter[TaskBase]:
     """The validator of task YAMLs, rebuilt when a task kind has been declared since."""
     global _TASK_ADAPTER
     kinds = tuple(TASK_MODELS)
@@ -158,8 +158,8 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
         try:
             if mount.robot is not None:
                 rpath = catalog.find("robots", mount.robot)
-            else:
-                rpath = (doc.path.parent / mount.robot_config_file).resolve()  # type: ignore[operator]
+            else:  # the mount model holds exactly one of the two
+                rpath = (doc.path.parent / str(mount.robot_config_file)).resolve()
                 if not rpath.is_file():
                     problems.append(doc.problem(loc, f"robot file not found: {rpath}"))
                     continue

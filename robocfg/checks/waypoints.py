@@ -10,7 +10,7 @@ functions for the joint-space forms).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +35,7 @@ class PositionLimits:
     bounded: np.ndarray
 
 
-def joint_waypoint(i: int, item: object, limits: PositionLimits, home: np.ndarray, prev: np.ndarray,
+def joint_waypoint(i: int, item: str | Sequence[float] | Mapping[str, float], limits: PositionLimits, home: np.ndarray, prev: np.ndarray,
                    problem: ProblemFn, problems: list[Problem]) -> tuple[str, np.ndarray | None]:
     """Joint values of a joint-space entry and its kind ('home', 'map', 'list'); (kind, None) when
     it is invalid (the reason appended to ``problems``). A map's unnamed joints keep ``prev``."""
@@ -48,7 +48,7 @@ def joint_waypoint(i: int, item: object, limits: PositionLimits, home: np.ndarra
             problems.append(problem((i,), f"unknown waypoint name {item!r}{did_you_mean(item, ['home'])} "
                                           "(the only named waypoint is 'home')"))
         return "home", q
-    if isinstance(item, dict):
+    if isinstance(item, Mapping):
         q = np.asarray(prev, dtype=float).copy()
         for jn, v in item.items():
             if jn not in names:
@@ -58,7 +58,7 @@ def joint_waypoint(i: int, item: object, limits: PositionLimits, home: np.ndarra
             q[names.index(jn)] = float(v)
         _check_within(i, q, limits, "map", problem, problems, set(item))
         return "map", q
-    values = list(item)  # type: ignore[call-overload]
+    values = list(item)
     if len(values) != len(names):
         problems.append(problem((i,), f"waypoint {i} has {len(values)} values for {len(names)} arm joints ({', '.join(names)})"))
         return "list", None

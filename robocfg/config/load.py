@@ -13,7 +13,7 @@ from typing import Any, TypeVar
 import yaml
 
 from robocfg.config.prescan import MAX_DEPTH, check_depth, check_size
-from robocfg.errors import ConfigError, Problem
+from robocfg.errors import ConfigError, Problem, Severity
 
 Loc = tuple[str | int, ...]
 M = TypeVar("M")
@@ -35,10 +35,10 @@ class YamlDocument:
                 return m
         return None
 
-    def problem(self, loc: Loc, message: str, severity: str = "error") -> Problem:
+    def problem(self, loc: Loc, message: str, severity: Severity = "error") -> Problem:
         mark = self.mark(loc)
         line, col = mark if mark else (None, None)
-        return Problem(str(self.path), line, col, format_loc(loc), message, severity)  # type: ignore[arg-type]
+        return Problem(str(self.path), line, col, format_loc(loc), message, severity)
 
 
 def format_loc(loc: Loc) -> str:
@@ -60,7 +60,8 @@ class _FastComposer(getattr(yaml, "CSafeLoader", _Composer)):  # type: ignore[mi
 # YAML 1.1 (PyYAML) reads ``1e-3`` as a string; numbers are validated strictly (no strings), so
 # exponents without a dot must resolve as floats, as in YAML 1.2.
 _EXP_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
-for _loader in {_Composer, _FastComposer}:
+_LOADERS: tuple[type[yaml.resolver.BaseResolver], ...] = (_Composer, _FastComposer)
+for _loader in _LOADERS:
     _loader.add_implicit_resolver("tag:yaml.org,2002:float", _EXP_FLOAT, list("-+0123456789."))
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal, cast
 
 from pydantic import Field, JsonValue, model_validator
 
@@ -16,6 +16,9 @@ from robocfg.config.commands import (
 )
 from robocfg.config.scene import Scene, Sim
 from robocfg.config.types import Frozen, Pose, SchemaVersion
+
+if TYPE_CHECKING:
+    from typing_extensions import TypeForm  # PEP 747; typing has it from Python 3.14
 
 
 class RobotMount(Pose):
@@ -130,9 +133,11 @@ def remove_task_kind(kind: str) -> None:
     TASK_MODELS.pop(kind, None)
 
 
-def task_union() -> object:
+def task_union() -> TypeForm[TaskBase]:
     """The discriminated union of every declared task kind (what a task YAML validates against)."""
     from functools import reduce
     from operator import or_
 
-    return Annotated[reduce(or_, TASK_MODELS.values()), Field(discriminator="task")]
+    # Built at run time from the kinds declared so far, so no static type expression spells it;
+    # every member is a TaskBase subclass, which is what the cast states.
+    return cast("TypeForm[TaskBase]", Annotated[reduce(or_, TASK_MODELS.values()), Field(discriminator="task")])

@@ -5,9 +5,11 @@ from __future__ import annotations
 
 import re
 import typing
+from collections.abc import Callable
 from typing import Any
 
 from pydantic import BaseModel, TypeAdapter, ValidationError
+from pydantic_core import ErrorDetails
 
 from robocfg.config.load import Loc, YamlDocument
 from robocfg.errors import ConfigError, Problem
@@ -16,6 +18,7 @@ from robocfg.suggest import did_you_mean
 
 def validate_document(doc: YamlDocument, model: Any) -> Any:
     """Validate ``doc.data`` against a pydantic model (or annotated union). Raises ConfigError."""
+    validate: Callable[[Any], Any]
     if isinstance(model, type) and issubclass(model, BaseModel):
         validate, tp = model.model_validate, model  # builds (once) and keeps the model's validator
     else:
@@ -65,7 +68,7 @@ def errors_to_problems(doc: YamlDocument, exc: ValidationError, model: Any) -> l
     return problems
 
 
-def _message(err: dict) -> str:
+def _message(err: ErrorDetails) -> str:
     msg = str(err["msg"])
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, ") :]
@@ -78,30 +81,32 @@ def _message(err: dict) -> str:
     return msg
 
 
-def _get(data: Any, loc: Loc) -> Any:
-    cur = data
-    for part in loc:
-        if (isinstance(cur, dict) and part in cur) or (isinstance(cur, list) and isinstance(part, int) and 0 <= part < len(cur)):
-            cur = cur[part]
-        else:
-            return None
-    return cur
-
-
 _MISSING = object()
+
+
+def _get(data: Any, loc: Loc) -> Any:
+    """Value at ``loc``, None where there is none."""
+    value = _lookup(data, loc)
+    return None if value is _MISSING else value
 
 
 def _lookup(data: Any, loc: Loc) -> Any:
     """Value at ``loc`` or ``_MISSING`` (unlike :func:`_get`, tells a null from an absent key)."""
     cur = data
     for part in loc:
-        if (isinstance(cur, dict) and part in cur) or (
-            isinstance(cur, list) and isinstance(part, int) and not isinstance(part, bool) and 0 <= part < len(cur)
-        ):
-            cur = cur[part]
-        else:
-            return _MISSING
+        cur = _child(cur, part)
+        if cur is _MISSING:
+            break
     return cur
+
+
+def _child(cur: Any, part: str | int) -> Any:
+    """``cur[part]`` of a mapping holding the key or a list holding the index ``part``, else ``_MISSING``."""
+    if isinstance(cur, dict):
+        return cur.get(part, _MISSING)
+    if isinstance(cur, list) and isinstance(part, int) and not isinstance(part, bool) and 0 <= part < len(cur):
+        return cur[part]
+    return _MISSING
 
 
 def _data_loc(model: Any, data: Any, loc: tuple, err_type: str = "") -> Loc:
@@ -180,7 +185,7 @@ def _type_at(model: Any, data: Any, loc: Loc) -> Any:
             tp = tp.model_fields[part].annotation
         else:
             return None
-        cur = cur[part] if isinstance(cur, (dict, list)) else None
+        cur = _get(cur, (part,))
     return tp
 
 

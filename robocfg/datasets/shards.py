@@ -134,7 +134,7 @@ def _read_hdf5(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeRecord,
 
     from robocfg.datasets.hdf5 import FILE_NAME
 
-    out = []
+    out: list[tuple[EpisodeRecord, dict]] = []
     with h5py.File(Path(shard.path) / FILE_NAME, "r") as f:
         for name in sorted(f["data"].keys(), key=lambda n: int(n.split("_")[1])):
             g = f["data"][name]

@@ -19,11 +19,16 @@ import io
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Final
 
 import numpy as np
 
-VIDEO_CODEC = "libx264"
+if TYPE_CHECKING:
+    from av.container import OutputContainer
+    from av.packet import Packet
+    from av.video.stream import VideoStream
+
+VIDEO_CODEC: Final = "libx264"
 # rc-lookahead=0 (which also turns macroblock-tree rate control off): with lookahead, x264 gave
 # the same frames a different bitstream now and then within one process (it depended on what the
 # process had done before); without it the bytes are a function of the frames alone.
@@ -46,7 +51,7 @@ def encode_episode(frames: np.ndarray, fps: int) -> EncodedVideo:
 
     buf = io.BytesIO()
     with av.open(buf, "w", format="mp4") as out:
-        stream: Any = cast(Any, out.add_stream(VIDEO_CODEC, rate=fps, options=dict(ENCODER_OPTIONS)))
+        stream = out.add_stream(VIDEO_CODEC, rate=fps, options=dict(ENCODER_OPTIONS))
         stream.width, stream.height, stream.pix_fmt = int(frames.shape[2]), int(frames.shape[1]), "yuv420p"
         stream.time_base = Fraction(1, fps)
         for i, rgb in enumerate(frames):
@@ -68,7 +73,12 @@ def rgb_to_yuv420p(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     m = x[: 2 * h, : 2 * w].reshape(h, 2, w, 2, 3).mean(axis=(1, 3))
     cb = 128.0 + (-37.797 * m[..., 0] - 74.203 * m[..., 1] + 112.0 * m[..., 2]) / 255.0
     cr = 128.0 + (112.0 * m[..., 0] - 93.786 * m[..., 1] - 18.214 * m[..., 2]) / 255.0
-    return tuple(np.clip(np.floor(c + 0.5), 0, 255).astype(np.uint8) for c in (y, cb, cr))  # type: ignore[return-value]
+    return _byte(y), _byte(cb), _byte(cr)
+
+
+def _byte(c: np.ndarray) -> np.ndarray:
+    """Values rounded half up and clipped to 0..255, as uint8."""
+    return np.clip(np.floor(c + 0.5), 0, 255).astype(np.uint8)
 
 
 def yuv420p_frame(rgb: np.ndarray):
@@ -78,7 +88,7 @@ def yuv420p_frame(rgb: np.ndarray):
 
     frame = av.VideoFrame(int(rgb.shape[1]), int(rgb.shape[0]), "yuv420p")
     for plane, data in zip(frame.planes, rgb_to_yuv420p(rgb), strict=True):
-        buf = np.frombuffer(plane, dtype=np.uint8).reshape(plane.height, plane.line_size)
+        buf = np.frombuffer(memoryview(plane), dtype=np.uint8).reshape(plane.height, plane.line_size)
         buf[:, plane.width:] = 0
         buf[:, : plane.width] = data
     return frame
@@ -91,8 +101,8 @@ class VideoConcat:
     def __init__(self, path: Path, fps: int):
         self.path, self.fps = Path(path), fps
         self.frames = 0
-        self._out: Any = None
-        self._stream: Any = None
+        self._out: OutputContainer | None = None
+        self._stream: VideoStream | None = None
 
     def append(self, seg: EncodedVideo) -> None:
         import av
@@ -100,18 +110,18 @@ class VideoConcat:
         if self._out is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._out = av.open(str(self.path), "w")
-        with av.open(io.BytesIO(seg.data)) as src:
+        out = self._out
+        with av.open(io.BytesIO(seg.data), "r") as src:
             s = src.streams.video[0]
             if self._stream is None:
-                self._stream = self._out.add_stream_from_template(s)
-            shift = int(Fraction(self.frames, self.fps) / s.time_base)
+                self._stream = out.add_stream_from_template(s)
+            shift = _ticks(self.frames, self.fps, s)
             for pkt in src.demux(s):
                 if pkt.dts is None:  # the demuxer's empty flush packet
                     continue
-                pkt.pts += shift
-                pkt.dts += shift
+                _shift(pkt, shift)
                 pkt.stream = self._stream
-                self._out.mux(pkt)
+                out.mux(pkt)
         self.frames += seg.frames
 
     def close(self) -> None:
@@ -134,12 +144,26 @@ def split_segments(path: Path, fps: int, lengths: list[int]) -> list[EncodedVide
             buf = io.BytesIO()
             with av.open(buf, "w", format="mp4") as out:
                 o = out.add_stream_from_template(s)
-                shift = int(Fraction(start, fps) / s.time_base)
+                shift = _ticks(start, fps, s)
                 for pkt in packets[start:start + n]:  # no B-frames: one packet per frame, in order
-                    pkt.pts -= shift
-                    pkt.dts -= shift
+                    _shift(pkt, -shift)
                     pkt.stream = o
                     out.mux(pkt)
             segs.append(EncodedVideo(buf.getvalue(), n))
             start += n
     return segs
+
+
+def _ticks(frames: int, fps: int, stream: VideoStream) -> int:
+    """The time of ``frames`` frames at ``fps`` in ticks of ``stream``'s time base (exact)."""
+    if stream.time_base is None:
+        raise ValueError("video stream without a time base")
+    return int(Fraction(frames, fps) / stream.time_base)
+
+
+def _shift(pkt: Packet, ticks: int) -> None:
+    """Move a packet's timestamps by ``ticks`` (its stream's time base)."""
+    if pkt.pts is not None:
+        pkt.pts += ticks
+    if pkt.dts is not None:
+        pkt.dts += ticks

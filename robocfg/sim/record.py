@@ -69,6 +69,7 @@ class Recorder:
     _next_t: float = field(default=0.0, init=False)
     _mirror: RenderMirror | None = field(default=None, init=False, repr=False)
     _markers_drawn: tuple | None = field(default=None, init=False, repr=False)
+    _renderer: str = field(default="auto", init=False, repr=False)  # ``renderer`` resolved
 
     def __post_init__(self) -> None:
         self.path = Path(self.path)
@@ -80,7 +81,7 @@ class Recorder:
         self.markers = task_markers(self.world)
         if self.settings is not None:
             self._apply(self.settings)
-        self.renderer = self.renderer or os.environ.get("ROBOCFG_RENDERER", "auto")
+        self.renderer = self._renderer = self.renderer or os.environ.get("ROBOCFG_RENDERER", "auto")
         if self.renderer not in RENDERERS:
             raise RobocfgError(f"unknown renderer {self.renderer!r}: one of {', '.join(RENDERERS)}")
         if self.camera is None:
@@ -95,22 +96,29 @@ class Recorder:
             c = s.camera
             self.camera = CameraView(target=c.target, distance=c.distance, yaw_deg=c.yaw_deg, pitch_deg=c.pitch_deg)
 
+    @property
+    def view(self) -> CameraView:
+        """The camera frames are taken from: ``camera``, or one fitted to the scene when None."""
+        if self.camera is None:
+            self.camera = scene_camera(self.world, self.size, self.markers)
+        return self.camera
+
     def view_projection(self) -> tuple[list[float], list[float]]:
         """PyBullet's (view, projection) matrices of the camera (column-major 16-lists)."""
-        return view_projection(self.world.client, self.camera, self.size)
+        return view_projection(self.world.client, self.view, self.size)
 
     def project(self, points) -> tuple[np.ndarray, np.ndarray]:
         """Pixel coordinates of world points in this recorder's frames (see :func:`project`)."""
-        return project(points, self.world.client, self.camera, self.size)
+        return project(points, self.world.client, self.view, self.size)
 
     def render(self) -> np.ndarray:
         """One RGB frame (H, W, 3) uint8 from the current state (no status overlay)."""
-        if self.renderer == "exact" or self.camera.shadow:
-            return render(self.world.client, self.camera, self.size)
+        if self._renderer == "exact" or self.view.shadow:
+            return render(self.world.client, self.view, self.size)
         if self._mirror is None:
-            self._mirror = make_mirror(self.world.client, self.renderer, self.max_faces)
+            self._mirror = make_mirror(self.world.client, self._renderer, self.max_faces)
         view, proj = self.view_projection()
-        return self._mirror.render(view, proj, self.size, self.camera.light_direction)
+        return self._mirror.render(view, proj, self.size, self.view.light_direction)
 
     def close(self) -> None:
         """Free the render mirror's PyBullet clients (:meth:`save` does it too)."""
@@ -192,18 +200,19 @@ class Recorder:
             self.frames, self.infos = self.frames[:-1], self.infos[:-1]
         self.frames.append(last)
         self.infos.append(info)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        path = Path(self.path)
+        path.parent.mkdir(parents=True, exist_ok=True)
         if self.sheet:
-            contact_sheet(self.frames, self.infos).save(self.path)
+            contact_sheet(self.frames, self.infos).save(path)
         elif not self.animate:
-            Image.fromarray(last).save(self.path)
-        elif self.path.suffix.lower() == ".mp4":
-            write_mp4(self.path, self.frames, self.fps)
+            Image.fromarray(last).save(path)
+        elif path.suffix.lower() == ".mp4":
+            write_mp4(path, self.frames, self.fps)
         else:
             hold = [*self.frames, *([last] * max(1, int(self.fps)))]  # the result stays up ≈ 1 s
-            write_gif(self.path, hold, self.fps)
+            write_gif(path, hold, self.fps)
         self.close()
-        return self.path
+        return path
 
 
 RENDERERS = ("auto", "tiny", "exact", "egl")
