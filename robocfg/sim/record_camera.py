@@ -139,6 +139,13 @@ def facing_camera(target, side_axis, away_from, distance: float = 0.5, elevation
     (e.g. a gripper's closing axis, so both fingers are seen side by side), on the side of ``target``
     away from the point ``away_from`` (e.g. the robot base), raised by ``elevation_deg``."""
     t = np.asarray(target, dtype=float)
+    eye = t + distance * facing_direction(t, side_axis, away_from, elevation_deg)
+    return CameraView(target=tuple(t.tolist()), eye=tuple(eye.tolist()))
+
+
+def facing_direction(target, side_axis, away_from, elevation_deg: float = 20.0) -> np.ndarray:
+    """The unit vector from ``target`` towards the eye of :func:`facing_camera` (world frame)."""
+    t = np.asarray(target, dtype=float)
     a = np.asarray(side_axis, dtype=float)
     n = np.cross([0.0, 0.0, 1.0], a)
     if np.linalg.norm(n[:2]) < 1e-6:  # closing axis vertical: look along x
@@ -147,8 +154,7 @@ def facing_camera(target, side_axis, away_from, distance: float = 0.5, elevation
     if np.dot(n[:2], (t - np.asarray(away_from, dtype=float))[:2]) < 0:
         n = -n
     e = np.radians(elevation_deg)
-    eye = t + distance * (np.cos(e) * n + np.sin(e) * np.array([0.0, 0.0, 1.0]))
-    return CameraView(target=tuple(t.tolist()), eye=tuple(eye.tolist()))
+    return np.cos(e) * n + np.sin(e) * np.array([0.0, 0.0, 1.0])
 
 
 def fit_camera(lo, hi, direction, fov_deg: float = 50.0, aspect: float = 4 / 3, margin: float = 1.08,

@@ -20,49 +20,26 @@ import io
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from functools import partial
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robocfg.checks import CheckedRobot
-from robocfg.config.robot import ParallelGripperConfig
+from robocfg.checks import CheckedTask
 from robocfg.errors import ConfigError
 from robocfg.geometry.pose import pose_matrix, pose_to_matrix
-from robocfg.geometry.rotation import matrix_to_quat
-from robocfg.viewer.frames import BOX_EDGES, ArmFrames, arm_frames, pad_boxes_ee
+from robocfg.viewer.frames import ArmFrames, arm_frames, pad_boxes_ee
 from robocfg.viewer.frusta import ShownCamera, add_frusta
 from robocfg.viewer.playback import Playback
 from robocfg.viewer.scenery import add_scenery
+from robocfg.viewer.shown import ShownRobot, add_robot, draw_frames, set_value, wxyz
 from robocfg.viewer.source import ViewSource
 
-LABEL_ANCHORS = ("bottom-left", "top-left", "bottom-right", "top-right")  # base, ee_link, TCP, grasp: apart
+if TYPE_CHECKING:
+    import viser
 
-
-def wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
-    """viser's (w, x, y, z) quaternion of a rotation matrix."""
-    x, y, z, w = matrix_to_quat(R)
-    return (float(w), float(x), float(y), float(z))
-
-
-@dataclass
-class ShownRobot:
-    """One robot on the page: its config, mount (4x4 world_T_root), URDF (yourdfpy) and joints."""
-
-    checked: CheckedRobot
-    mount: np.ndarray
-    node: str
-    urdf: object  # yourdfpy.URDF
-    shown: object  # viser.extras.ViserUrdf
-    q: dict[str, float] = field(default_factory=dict)  # actuated joint → value (rad or m)
-
-    def link_pose(self, link: str) -> np.ndarray:
-        """World pose (4x4) of ``link`` at the joint values last sent with :meth:`apply`."""
-        return self.mount @ self.urdf.get_transform(link, self.urdf.base_link)  # type: ignore[attr-defined]
-
-    def apply(self) -> None:
-        names = self.urdf.actuated_joint_names  # type: ignore[attr-defined]
-        self.shown.update_cfg(np.array([self.q.get(n, 0.0) for n in names]))  # type: ignore[attr-defined]
+    from robocfg.kinematics.model import KinematicModel
 
 
 class BrowserViewer:
@@ -74,7 +51,7 @@ class BrowserViewer:
 
         self.source, self.q0 = source, None if q is None else list(q)
         self.playback = playback
-        self.scenery: dict[str, object] = {}
+        self.scenery: dict[str, viser.GlbHandle] = {}
         self._playing = threading.Event()
         self._player: threading.Thread | None = None
         with contextlib.redirect_stdout(io.StringIO()):  # viser prints a banner whatever ``verbose`` says
@@ -82,12 +59,12 @@ class BrowserViewer:
         self.lock = threading.RLock()
         self.robots: list[ShownRobot] = []
         self.frames: list[ArmFrames] = []
-        self.sliders: dict[str, object] = {}
+        self.sliders: dict[str, viser.GuiSliderHandle[float]] = {}
         self.cameras: list[ShownCamera] = []
         self.errors: list[str] = []
-        self.watched: list = [source.path]
+        self.watched: list[Path] = [source.path]
         self.ik_status = ""
-        self._model = None
+        self._model: KinematicModel | None = None
         self._syncing = False
         try:
             self.reload()
@@ -117,13 +94,15 @@ class BrowserViewer:
             self.errors = []
             robots = self.source.robots(checked)
             self.watched = [self.source.path, *(r.path for r in robots)]
-            mounts = [np.eye(4)] if self.source.kind == "robot" else [pose_matrix(m) for m in checked.config.robots]
-            if self.source.kind == "task":
-                self.scenery = add_scenery(self.server, checked)
+            task = checked if isinstance(checked, CheckedTask) else None
+            mounts = [np.eye(4)] if task is None else [pose_matrix(m) for m in task.config.robots]
+            if task is not None:
+                self.scenery = add_scenery(self.server, task)
             for k, (robot, mount) in enumerate(zip(robots, mounts, strict=True)):
-                self.robots.append(self._add_robot(robot, mount, f"/robot{k}"))
-            if self.source.kind == "task":
-                self.cameras = add_frusta(self.server, list(checked.config.cameras), self._ee_pose(), wxyz)
+                q0 = self.q0 if not self.robots else None
+                self.robots.append(add_robot(self.server, robot, mount, f"/robot{k}", q0))
+            if task is not None:
+                self.cameras = add_frusta(self.server, list(task.config.cameras), self._ee_pose(), wxyz)
             self._add_gui()
             if self.playback is not None:
                 self._add_playback_gui(self.playback)
@@ -132,7 +111,7 @@ class BrowserViewer:
 
     def _fit_camera(self) -> None:
         """Ground grid and initial camera sized to the robots (a 3 m KR210 as well as a Panda)."""
-        pts = np.array([r.link_pose(link)[:3, 3] for r in self.robots for link in r.urdf.link_map])  # type: ignore[attr-defined]
+        pts = np.array([r.link_pose(link)[:3, 3] for r in self.robots for link in r.urdf.link_map])
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         size = float(max(np.max(hi - lo), 0.3))
         centre = (lo + hi) / 2
@@ -141,29 +120,6 @@ class BrowserViewer:
                                    position=(float(centre[0]), float(centre[1]), 0.0))
         self.server.initial_camera.look_at = tuple(centre)
         self.server.initial_camera.position = tuple(centre + size * np.array([1.0, -0.85, 0.55]))
-
-    def _add_robot(self, robot: CheckedRobot, mount: np.ndarray, node: str) -> ShownRobot:
-        import yourdfpy
-        from viser.extras import ViserUrdf
-
-        from robocfg.sim.loading import prepared_urdf
-
-        path = prepared_urdf(robot)
-        urdf = yourdfpy.URDF.load(path, build_scene_graph=True, load_meshes=True, build_collision_scene_graph=True,
-                                  load_collision_meshes=True,
-                                  filename_handler=partial(yourdfpy.filename_handler_magic, dir=path.parent))
-        self.server.scene.add_frame(node, show_axes=False, position=tuple(mount[:3, 3]), wxyz=wxyz(mount[:3, :3]))
-        shown = ViserUrdf(self.server, urdf, root_node_name=node, load_collision_meshes=True,
-                          collision_mesh_color_override=(0.1, 0.7, 0.8, 0.5))
-        shown.show_collision = False
-        out = ShownRobot(robot, mount, node, urdf, shown)
-        for k, arm in enumerate(robot.config.arms):
-            q = self.q0 if (k == 0 and not self.robots and self.q0 is not None) else arm.home
-            out.q.update(zip(robot.arm_joints(arm), (float(v) for v in q), strict=True))
-            g = arm.gripper
-            if isinstance(g, ParallelGripperConfig):  # one-jaw grippers included (a subclass)
-                out.q.update(zip(robot.gripper_joints(arm), g.open, strict=True))
-        return out
 
     def _add_gui(self) -> None:
         gui, first = self.server.gui, self.robots[0]
@@ -174,12 +130,12 @@ class BrowserViewer:
         @coll.on_update
         def _(_event) -> None:
             for r in self.robots:
-                r.shown.show_collision = coll.value  # type: ignore[attr-defined]
+                r.shown.show_collision = coll.value
 
         self.collision_checkbox = coll
-        limits = first.shown.get_actuated_joint_limits()  # type: ignore[attr-defined]
+        limits = first.shown.get_actuated_joint_limits()
         with gui.add_folder("joints"):
-            for name in first.urdf.actuated_joint_names:  # type: ignore[attr-defined]
+            for name in first.urdf.actuated_joint_names:
                 lo, hi = limits[name]
                 lo, hi = (-np.pi, np.pi) if lo is None or hi is None else (lo, hi)
                 s = gui.add_slider(name, min=float(lo), max=float(hi), step=float(hi - lo) / 200,
@@ -222,7 +178,7 @@ class BrowserViewer:
                 handle = self.scenery.get(name)
                 if handle is not None:
                     x, y, z, w = quat
-                    handle.position, handle.wxyz = pos, (w, x, y, z)  # type: ignore[attr-defined]
+                    handle.position, handle.wxyz = pos, (w, x, y, z)
             self._phase_text.content = f"t = {frame.t:.2f} s, phase: {frame.phase or 'start'}"
             self.refresh()
 
@@ -243,14 +199,14 @@ class BrowserViewer:
         start = time.monotonic() - t
         while self._playing.is_set() and t < self.playback.duration:
             t = min(time.monotonic() - start, self.playback.duration)
-            self.time_slider.value = t  # its update handler poses the scene
+            set_value(self.time_slider, t)  # its update handler poses the scene
             time.sleep(step)
         self._playing.clear()
 
     # ---- updates ------------------------------------------------------------------------
     def _on_slider(self, name: str, _event) -> None:
         if not self._syncing:
-            self.set_joint(name, float(self.sliders[name].value))  # type: ignore[attr-defined]
+            self.set_joint(name, float(self.sliders[name].value))
 
     def set_joint(self, name: str, value: float) -> None:
         """Move one joint of the first robot (as its slider does); the gizmo goes to the new TCP."""
@@ -290,7 +246,7 @@ class BrowserViewer:
                 for arm in r.checked.config.arms:
                     f = arm_frames(arm, r.link_pose, pad_boxes_ee(r.checked, arm), length)
                     self.frames.append(f)
-                    self._draw(f, f"{r.node}_frames/{arm.name}")
+                    draw_frames(self.server.scene, f, f"{r.node}_frames/{arm.name}")
             T_ee = self._ee_pose()
             for cam in self.cameras:
                 if cam.camera.mount == "ee":
@@ -299,8 +255,8 @@ class BrowserViewer:
             try:
                 for name, s in self.sliders.items():
                     v = self.robots[0].q.get(name, 0.0)
-                    if abs(s.value - v) > 1e-9:  # type: ignore[attr-defined]
-                        s.value = v  # type: ignore[attr-defined]
+                    if abs(s.value - v) > 1e-9:
+                        set_value(s, v)
             finally:
                 self._syncing = False
 
@@ -310,19 +266,6 @@ class BrowserViewer:
             return None
         first = self.robots[0]
         return first.link_pose(first.checked.config.arms[0].ee_link)
-
-    def _draw(self, f: ArmFrames, node: str) -> None:
-        scene = self.server.scene
-        for k, tri in enumerate(f.triads):
-            name = f"{node}/triad{k}"
-            scene.add_frame(name, axes_length=tri.length, axes_radius=tri.length * 0.05,
-                            position=tuple(tri.pose[:3, 3]), wxyz=wxyz(tri.pose[:3, :3]))
-            scene.add_label(f"{name}/label", tri.label, anchor=LABEL_ANCHORS[k])
-        seg = np.array([[f.ee_axis.start, f.ee_axis.end]])
-        scene.add_line_segments(f"{node}/ee_axis", seg, (200, 0, 200), thickness=4.0, thickness_units="screen")
-        if f.pads:
-            pads = np.array([[pad.corners[i], pad.corners[j]] for pad in f.pads for i, j in BOX_EDGES])
-            scene.add_line_segments(f"{node}/pads", pads, (255, 140, 0), thickness=3.0, thickness_units="screen")
 
     def scene_names(self) -> list[str]:
         """Names of the scene nodes the server holds (robot links, frames, scenery)."""

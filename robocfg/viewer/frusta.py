@@ -10,12 +10,17 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robocfg.config.cameras import TaskCamera
 
+if TYPE_CHECKING:
+    import viser
+
 FRUSTUM_COLOR = (30, 120, 255)
+Wxyz = tuple[float, float, float, float]  # a quaternion as viser takes it
 
 
 def camera_pose(cam: TaskCamera, T_mount: np.ndarray | None = None) -> np.ndarray:
@@ -41,16 +46,17 @@ class ShownCamera:
     """A frustum on the page: its camera and the scene handle to re-pose."""
 
     camera: TaskCamera
-    handle: object  # viser CameraFrustumHandle
+    handle: viser.CameraFrustumHandle
 
-    def place(self, T_ee: np.ndarray | None, wxyz: Callable[[np.ndarray], tuple]) -> None:
+    def place(self, T_ee: np.ndarray | None, wxyz: Callable[[np.ndarray], Wxyz]) -> None:
+        """Pose the frustum (``T_ee``: the world pose of the ``ee_link``, for ``mount: ee``)."""
         T = camera_pose(self.camera, T_ee)
-        self.handle.position = tuple(float(v) for v in T[:3, 3])  # type: ignore[attr-defined]
-        self.handle.wxyz = wxyz(T[:3, :3])  # type: ignore[attr-defined]
+        self.handle.position = (float(T[0, 3]), float(T[1, 3]), float(T[2, 3]))
+        self.handle.wxyz = wxyz(T[:3, :3])
 
 
-def add_frusta(server, cameras: list[TaskCamera], T_ee: np.ndarray | None,
-               wxyz: Callable[[np.ndarray], tuple]) -> list[ShownCamera]:
+def add_frusta(server: viser.ViserServer, cameras: list[TaskCamera], T_ee: np.ndarray | None,
+               wxyz: Callable[[np.ndarray], Wxyz]) -> list[ShownCamera]:
     """A labelled frustum per camera under ``/cameras`` (depth of the drawing: 0.12 m)."""
     out = []
     for cam in cameras:

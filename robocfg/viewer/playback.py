@@ -16,6 +16,7 @@ from robocfg.errors import RobocfgError
 
 PLAYBACK_FPS = 30.0
 STATIC_BODIES = ("ground", "table", "pedestal")  # never move: not sampled
+BodyPose = tuple[tuple[float, float, float], tuple[float, float, float, float]]  # (position m, quat xyzw)
 
 
 @dataclass(frozen=True)
@@ -26,7 +27,7 @@ class PlaybackFrame:
     t: float
     phase: str
     joints: tuple[dict[str, float], ...]
-    bodies: dict[str, tuple[tuple[float, float, float], tuple[float, float, float, float]]]
+    bodies: dict[str, BodyPose]
 
 
 @dataclass
@@ -75,13 +76,13 @@ class StateRecorder(EpisodeObserver):
         robots = {r.name for r in w.robots}
         joints = tuple({n: float(v) for n, v in zip(r.movable_joints, r.joint_positions(), strict=True)}
                        for r in w.robots)
-        bodies = {}
+        bodies: dict[str, BodyPose] = {}
         for name in list(w.bodies):
             if name in robots or name in STATIC_BODIES or name.startswith(("table_leg_", "_")):
                 continue
-            pos, quat = w.body_pose(name)
-            bodies[name] = (tuple(float(v) for v in pos), tuple(float(v) for v in quat))
-        self.playback.frames.append(PlaybackFrame(float(w.t), self.phase, joints, bodies))  # type: ignore[arg-type]
+            (x, y, z), (qx, qy, qz, qw) = w.body_pose(name)
+            bodies[name] = ((float(x), float(y), float(z)), (float(qx), float(qy), float(qz), float(qw)))
+        self.playback.frames.append(PlaybackFrame(float(w.t), self.phase, joints, bodies))
 
     def set_phase(self, name: str) -> None:
         self.phase = name

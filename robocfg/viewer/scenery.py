@@ -4,12 +4,17 @@ in each body's own frame, then posed in the world (m); a ``mesh`` body is loaded
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import trimesh
 
 from robocfg.checks import CheckedTask
 from robocfg.config.scene import Body
 from robocfg.geometry.pose import pose_matrix
+
+if TYPE_CHECKING:
+    import viser
 
 PLACE_COLOR = (40, 200, 60, 110)
 
@@ -31,17 +36,21 @@ def body_mesh(body: Body, base_dir) -> trimesh.Trimesh | None:
         loaded = trimesh.load(resolve_asset(body.mesh or "", base_dir), force="mesh")
     except (OSError, ValueError):
         return None
+    if not isinstance(loaded, trimesh.Trimesh):  # force="mesh" gives one; anything else is unreadable
+        return None
     loaded.apply_scale(s)
     return loaded
 
 
 def _colored(mesh: trimesh.Trimesh, rgba) -> trimesh.Trimesh:
+    """``mesh`` in the colour ``rgba`` (0..1 or 0..255); a textured mesh keeps its texture."""
     c = np.asarray(rgba, float)
-    mesh.visual.face_colors = np.clip(np.round(c if c.max() > 1 else c * 255), 0, 255).astype(np.uint8)
+    if isinstance(mesh.visual, trimesh.visual.ColorVisuals):
+        mesh.visual.face_colors = np.clip(np.round(c if c.max() > 1 else c * 255), 0, 255).astype(np.uint8)
     return mesh
 
 
-def add_scenery(server, task: CheckedTask) -> dict[str, object]:
+def add_scenery(server: viser.ViserServer, task: CheckedTask) -> dict[str, viser.GlbHandle]:
     """Add the task's bodies to ``server``'s scene; returns the scene handles by body name (a
     body's mesh is in its own frame and the handle carries its pose, so a playback can move it)."""
     from robocfg.geometry.rotation import matrix_to_quat
@@ -71,9 +80,9 @@ def add_scenery(server, task: CheckedTask) -> dict[str, object]:
         mesh = body_mesh(b, base)
         if mesh is not None:
             items.append((b.name, _colored(mesh, b.color), pose_matrix(b)))
-    handles = {}
+    handles: dict[str, viser.GlbHandle] = {}
     for name, mesh, T in items:
         x, y, z, w = matrix_to_quat(T[:3, :3])
-        handles[name] = server.scene.add_mesh_trimesh(f"/scene/{name}", mesh, position=tuple(float(v) for v in T[:3, 3]),
+        handles[name] = server.scene.add_mesh_trimesh(f"/scene/{name}", mesh, position=(float(T[0, 3]), float(T[1, 3]), float(T[2, 3])),
                                                       wxyz=(float(w), float(x), float(y), float(z)))
     return handles

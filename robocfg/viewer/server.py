@@ -15,8 +15,9 @@ from robocfg.viewer.playback import Playback
 from robocfg.viewer.source import ViewSource
 
 
-def _stamps(paths: Sequence[Path]) -> tuple:
-    out = []
+def _stamps(paths: Sequence[Path]) -> tuple[tuple[str, int | None, int | None], ...]:
+    """(path, modification time in ns, size in bytes) of each file; None, None where it is missing."""
+    out: list[tuple[str, int | None, int | None]] = []
     for p in paths:
         try:
             st = Path(p).stat()

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from PIL import Image, ImageDraw
 
-from robocfg.sim.record_camera import CameraView, facing_camera, fit_camera, project, render
+from robocfg.sim.record_camera import CameraView, facing_direction, fit_camera, project, render
 from robocfg.sim.still_scene import StillScene
 from robocfg.viewer.frames import ArmFrames, arm_frames, box_corners, pad_boxes_ee
 from robocfg.viewer.overlay import (
@@ -93,12 +93,12 @@ def tool_camera(scene: StillScene, frames: ArmFrames) -> CameraView:
     tcp = frames.tcp()
     closing = frames.triads[3].pose[:3, 1]
     base = frames.triads[0].pose[:3, 3]
-    look = facing_camera(tcp, closing, away_from=base)
+    look = facing_direction(tcp, closing, away_from=base)
     tips = [tri.pose[:3, 3] + tri.length * tri.pose[:3, a] for tri in frames.triads[1:] for a in range(3)]
     pts = [T_ee[:3, 3], tcp, *tips]
     pts += [c for pad in frames.pads for c in pad.corners]
     P = np.array(pts)
-    return fit_camera(P.min(axis=0), P.max(axis=0), np.subtract(look.eye, look.target), margin=1.25)
+    return fit_camera(P.min(axis=0), P.max(axis=0), look, margin=1.25)
 
 
 def robot_sheet(scene: StillScene, header: list[str], collision: bool = False) -> Image.Image:

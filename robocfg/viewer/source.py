@@ -51,8 +51,9 @@ def _find(name_or_path: str) -> ViewSource:
         kind = detect_kind(load_yaml(path))
         return ViewSource("robot" if kind == "robot" else "task", path)
     robots, tasks = catalog.available("robots"), catalog.available("tasks")
-    for kind, found in (("robot", robots), ("task", tasks)):
+    kinds: tuple[tuple[Literal["robot", "task"], dict[str, Path]], ...] = (("robot", robots), ("task", tasks))
+    for kind, found in kinds:
         for name in (name_or_path, name_or_path.replace("-", "_"), Path(name_or_path).stem):
             if name in found:
-                return ViewSource(kind, found[name])  # type: ignore[arg-type]
+                return ViewSource(kind, found[name])
     raise NotFound("robot or task", name_or_path, [*robots, *tasks])
