@@ -50,6 +50,12 @@ class ParallelGripperConfig(Frozen):
         "0.9 makes any grasp read as closed: the gripper counts as open only when (nearly) fully open.",
     )
     lateral_friction: PositiveFloat = Field(1.0, description="Friction coefficient given to the finger links.")
+    pad_patch_radius: NonNegFloat = Field(
+        0.005,
+        description="Radius (m) of the contact patch a soft finger pad makes on a gripped object; gives the "
+        "pads' torsional friction (2/3 · lateral_friction · radius, m), which keeps an object gripped at two "
+        "points (a curved mesh) from swinging about the closing axis. 0: point contacts.",
+    )
 
     @model_validator(mode="after")
     def _shape(self) -> ParallelGripperConfig:

@@ -49,8 +49,13 @@ class ParallelGripper(Gripper):
         self.force = cfg.max_force
         gains = self.robot.config.drives.arm
         self._gains = (gains.stiffness, gains.damping)
+        # A soft pad pressed on an object touches it over a patch, not at a point: uniform pressure over a
+        # disc of radius a resists turning with up to (2/3)·μ·a·N (N·m). Bullet multiplies a body's
+        # spinning friction by the other body's lateral friction, so the object's μ completes the product.
+        spinning = 2.0 / 3.0 * cfg.lateral_friction * cfg.pad_patch_radius
         for f in self.fingers:
-            p.changeDynamics(self.robot.body_id, f, lateralFriction=cfg.lateral_friction, physicsClientId=self.client)
+            p.changeDynamics(self.robot.body_id, f, lateralFriction=cfg.lateral_friction, spinningFriction=spinning,
+                             physicsClientId=self.client)
         self._curve: tuple[np.ndarray, np.ndarray] | None = None  # (fractions, gaps), on first set_width
         self._curve_done = False
         self._goal = 1.0  # commanded opening fraction (0 closed, 1 open)
