@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from pydantic import TypeAdapter
 
+from robocfg.checks.grip_force import check_grip_force
 from robocfg.checks.object_fit import check_object_fit
 from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.scene import check_scene
@@ -197,7 +198,7 @@ def _check_pick_place(doc: YamlDocument, task: PickPlaceTask, robot: CheckedRobo
     if g is None:
         problems.append(doc.problem(("robots", 0), f"robot {robot.config.name!r} has no gripper (arms[0].gripper is missing in {robot.path}); pick-place needs one"))
         return
-    for problem in check_object_fit(doc, task, robot, arm):
+    for problem in check_object_fit(doc, task, robot, arm) + check_grip_force(doc, task, robot, arm):
         (warnings if problem.severity == "warning" else problems).append(problem)
     place = np.asarray(task.pick_place.place_position)
     for k, ob in enumerate(task.scene.obstacles):

@@ -41,6 +41,8 @@ SAME_WIDTH = 0.001  # m: widths closer than this count as equal when ordering di
 SURFACE_CHECK_POINTS = 400  # object points the top-down grasp height is checked with
 SURFACE_POINTS = 1500  # object points sampled for the antipodal planner
 MESH_CANDIDATES = 4  # antipodal grasps handed on to the reach/travel choice
+MESH_POOL = 12  # antipodal grasps ranked by their lever arm before MESH_CANDIDATES are kept
+LEVER_STEP = 0.005  # m: lever arms closer than this count as equal (the planner's order decides)
 
 
 @dataclass(frozen=True)
@@ -136,14 +138,26 @@ def _grasp_height(obj: LyingObject, boxes: GripperBoxes, closing: np.ndarray, wi
 
 def mesh_grasps(obj: LyingObject, boxes: GripperBoxes, rng: np.random.Generator, standoff: float,
                 reach: Callable[[Grasp], tuple[Grasp, np.ndarray] | None] | None = None) -> list[Grasp]:
-    """Antipodal grasps on the object's own surface (best first, at most ``MESH_CANDIDATES``),
-    checked against the support and the object itself, and by ``reach`` when given."""
+    """Antipodal grasps on the object's own surface (at most ``MESH_CANDIDATES``), checked against
+    the support and the object itself, and by ``reach`` when given; of the planner's best
+    ``MESH_POOL``, those whose closing line passes nearest the centre of mass first (``lever_arm``:
+    two pads hold an object against turning about that line by friction alone, so gravity's lever
+    about it is what tips the object in the hand), the planner's order among equals."""
     pts, nrm = obj.shape.surface(SURFACE_POINTS, rng)
     P = pts @ obj.rotation.T + obj.position
     N = nrm @ obj.rotation.T
-    settings = PlannerSettings(standoff=standoff, top_k=MESH_CANDIDATES, clearance=CLEARANCE)
+    settings = PlannerSettings(standoff=standoff, top_k=MESH_POOL, clearance=CLEARANCE)
     plan = plan_grasps(P, N, P, obj.support_z, boxes, settings, rng, reach=reach)
-    return [c.grasp for c in plan.candidates]
+    grasps = [c.grasp for c in plan.candidates]
+    order = sorted(range(len(grasps)), key=lambda i: (round(lever_arm(grasps[i], obj.position) / LEVER_STEP), i))
+    return [grasps[i] for i in order[:MESH_CANDIDATES]]
+
+
+def lever_arm(grasp: Grasp, com: np.ndarray) -> float:
+    """Distance (m) from the centre of mass ``com`` (world) to the grasp's closing line (through
+    its centre along its y axis)."""
+    d = np.asarray(com, float) - grasp.center
+    return float(np.linalg.norm(np.cross(d, grasp.rotation[:, 1])))
 
 
 def suction_grasps(obj: LyingObject, press: float) -> list[Grasp]:

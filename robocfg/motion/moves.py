@@ -39,6 +39,8 @@ TIMEOUT_FACTOR = 1.25  # a move without a fixed timeout may take its planned dur
 TIMEOUT_MARGIN = 1.0  # ... + this many seconds (s) to settle and converge
 UNPLANNED_TIMEOUT = 4.0  # s: the limit of a move that has no plan to measure (convergence only)
 REACTIVE_DETOUR = 2.0  # a reactive move may take this many times the direct move (it goes round obstacles)
+ACCEL_SAMPLES = 41  # instants at which a move's EE acceleration is measured against max_acceleration
+MIN_ACCELERATION = 0.5  # m/s²: the lowest EE acceleration limit honoured (a tighter one would crawl)
 IK_ITERATIONS = 400  # LM iterations per IK query over all restarts (see bound_ik_by_iterations)
 
 
@@ -81,6 +83,7 @@ class ArmMover:
     on_step: Callable[[], None] | None = None
     phase: str = "move"
     ik_budget: float = 1.0  # s of wall clock per IK query: a safety net (bound_ik_by_iterations binds)
+    max_acceleration: float | None = None  # m/s²: the EE's peak acceleration in a timed move (a held load), None: free
 
     def solve(self, T: np.ndarray, seed: np.ndarray, what: str = "") -> np.ndarray:
         res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
@@ -129,6 +132,8 @@ class ArmMover:
             W = np.asarray([q0, q_goal])
         if np.max(np.abs(W[-1] - W[0])) >= 1e-6:
             traj = MinJerkPath(W, self.limits)
+            if self.max_acceleration is not None:
+                traj.duration *= self._stretch(traj, self.max_acceleration)
             if self.timeout is not None and traj.duration > self.timeout:
                 raise MoveFailed(self.phase, f"motion needs {traj.duration:.2f} s, more than the {self.timeout:.2f} s timeout")
             t_start = self.world.t
@@ -164,6 +169,16 @@ class ArmMover:
             reason = check()
             if reason:
                 raise MoveFailed(self.phase, reason)
+
+    def _stretch(self, traj, a_max: float) -> float:
+        """Factor (≥ 1) by which to slow ``traj`` so that the EE's peak acceleration (m/s², from
+        FK at ``ACCEL_SAMPLES`` instants, second differences) stays within ``a_max``: time scaled
+        by c scales accelerations by 1/c²."""
+        t = np.linspace(0.0, traj.duration, ACCEL_SAMPLES)
+        q, _, _ = traj.evaluate(t)
+        P = np.array([self.model.fk(qi, "ee")[:3, 3] for qi in q])
+        peak = float(np.linalg.norm(np.diff(P, 2, axis=0), axis=1).max()) / (t[1] - t[0]) ** 2
+        return max(1.0, math.sqrt(peak / max(a_max, MIN_ACCELERATION)))
 
     def play(self, traj) -> None:
         """Send the trajectory's position and velocity targets every physics step (no tracking

@@ -79,6 +79,7 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
 
     def prepare(self) -> None:
         from robocfg.assets.object_shape import object_shape
+        from robocfg.checks.grip_force import pad_force
         from robocfg.grasp.gripper_model import measure_gripper
         from robocfg.kinematics.model import KinematicModel
         from robocfg.motion.limits import limits_from_robot
@@ -100,10 +101,12 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
         scale = self.params.speed_scale
         boxes = measure_gripper(self.world.robot, self.handle) if isinstance(self.arm_cfg.gripper, ParallelGripperConfig) else None
+        force = pad_force(robot, self.arm_cfg)
         self.tools = _Tools(model, limits_from_robot(robot, self.handle.joints,
                                                      Limits(velocity_scale=scale, acceleration_scale=scale)),
                             reactive_drive(robot, self.world, self.arm_cfg.name, self.params, shape),
-                            planned_drive(robot, self.world, model, self.params), shape=shape, boxes=boxes)
+                            planned_drive(robot, self.world, model, self.params), shape=shape, boxes=boxes,
+                            pad_force=force)
 
     def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
         setup = episode_setup(self.params, self.seed, k)

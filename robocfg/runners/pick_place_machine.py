@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from robocfg.assets.object_shape import ObjectShape, object_shape
+from robocfg.checks.grip_force import PadForce, grip_budget
 from robocfg.config.commands import PickPlaceParams
 from robocfg.config.scene import Body
 from robocfg.geometry import quat_to_matrix, rotation_angle
@@ -40,7 +41,10 @@ if TYPE_CHECKING:
 
 Log = Callable[[str], None]
 SETTLE_POLL = 4  # physics steps between checks while waiting
-RELEASE_CLEARANCE = 0.004  # m: how far above the support the object is let go
+# m: how far above the support the object is let go — its lowest point as it hangs in the hand. A
+# drop of a few mm sets an object rocking, and one standing on a narrow base (a duck on its belly)
+# then topples after the fingers have left.
+RELEASE_CLEARANCE = 0.001
 SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
 # Bullet lets a ball or a lying cylinder creep and roll away on a level plane from rest; a little
 # rolling/spinning friction (m) on round objects stops that artefact without changing the grasp.
@@ -66,7 +70,7 @@ class _Tools:
     planned``, the global planner), the object's geometry
     (:class:`~robocfg.assets.object_shape.ObjectShape`; None: read from the episode's body) and the
     parallel gripper's measured boxes (:class:`~robocfg.grasp.gripper_model.GripperBoxes`; None for
-    suction)."""
+    suction) and pad force (:class:`~robocfg.checks.grip_force.PadForce`; None for suction)."""
 
     model: Any
     limits: Any
@@ -74,6 +78,7 @@ class _Tools:
     planned: Any = None  # motion: planned — a robocfg.planning.drive.PlannedDrive
     shape: ObjectShape | None = None
     boxes: GripperBoxes | None = None
+    pad_force: PadForce | None = None  # each pad's normal force at the force limit (parallel grippers)
 
 
 def reactive_drive(robot, world: World, arm_name: str, params: PickPlaceParams, shape: ObjectShape):
@@ -126,6 +131,7 @@ class _StateMachine:
             self.gripper.set_force(params.grip_force)
         self.shape = tools.shape or object_shape(setup.body, world.task.path.parent)
         self.boxes = tools.boxes
+        self.pad_force = tools.pad_force
         self.obj = world.add_body(setup.body)
         if self.shape.symmetry != "none":
             world.set_dynamics(self.obj, rolling_friction=ROLLING_FRICTION, spinning_friction=ROLLING_FRICTION)
@@ -154,16 +160,19 @@ class _StateMachine:
         self.mover.move(T_grasp, straight=True)
         self.begin("grasp", "close the gripper")
         self.mover.close_until_held(self.obj, p.timeouts.grasp)
+        self._limit_acceleration()
         self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
         z0 = self.world.body_pose(self.obj)[0][2]
         T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
         self.mover.move(T_lift, straight=True)
         self._verify_lift(z0)
         # Carry the object so that *it* lands on the place point: keep its offset from the EE.
-        obj_now = self.world.body_pose(self.obj)[0]
+        obj_now, quat_now = self.world.body_pose(self.obj)
         ee_now = self.arm.ee_pose()[:3, 3]
         offset = ee_now - obj_now
-        place_z = self._support_height(self.setup.place_xy) + self.shape.below_origin(self.R0) + RELEASE_CLEARANCE
+        # its lowest point as it now hangs in the hand (it may have turned a little in the grasp)
+        below = self.shape.below_origin(quat_to_matrix(quat_now))
+        place_z = self._support_height(self.setup.place_xy) + below + RELEASE_CLEARANCE
         place_obj = np.array([*self.setup.place_xy, place_z])
         T_place = T_lift.copy()
         T_place[:3, 3] = place_obj + offset
@@ -176,6 +185,7 @@ class _StateMachine:
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
         self.begin("release", "open the gripper")
+        self.mover.max_acceleration = None
         self._release()
         if self.planned is not None:
             self.planned.detach(self.setup.body.name)
@@ -293,6 +303,24 @@ class _StateMachine:
         if abs(z - pos[2]) > REST_TOLERANCE:
             self.world.set_body_pose(self.obj, [pos[0], pos[1], z], quat)
         return R
+
+    def _limit_acceleration(self) -> None:
+        """Carry the object no harder than the grip holds it (:mod:`robocfg.checks.grip_force`):
+        the timed moves that hold it (lift, transport, lower) keep the EE's acceleration within
+        what friction at the gripper's force (the task's ``grip_force``, else ``max_force``) carries."""
+        width = self.gripper.width()
+        if width is None:
+            return
+        body = self.setup.body
+        budget = grip_budget(self.cfg, self.pad_force, body.mass, body.friction, width)
+        if budget is None:
+            return
+        if self.params.grip_force is not None:  # the task's force instead of the limit: the pad force scales with it
+            budget = replace(budget, pad_force=budget.pad_force * self.params.grip_force / budget.limit)
+        a = budget.max_acceleration()
+        self.mover.max_acceleration = a
+        self.log(f"  grip: {budget.pad_force:.1f} N per pad at {width * 1000:.0f} mm; the held object may "
+                 f"be accelerated up to {a:.1f} m/s²")
 
     def _release(self) -> None:
         t0 = self.world.t
