@@ -40,6 +40,7 @@ def test_validate_warns_and_run_fails_before_simulating(tmp_path, capsys, monkey
     code, _, err = run_main(["validate", str(path)], capsys, monkeypatch)
     assert code == 0
     assert "pick_place.object.position: warning: pre_grasp: the pose above the object is unreachable, out of the arm's reach" in err
+    assert "give them relative to the arm with 'placement: reach'" in err  # what to do about it
     out_json = tmp_path / "r.json"
     code, out, err = run_main(["run", "pick-place", str(path), "-n", "2", "-q", "--json", str(out_json)], capsys, monkeypatch)
     assert code == 1

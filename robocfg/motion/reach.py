@@ -32,6 +32,8 @@ from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
 
 YAW_STEPS = 6  # tool turns about the vertical tried over half a turn
 IK_BUDGET = 0.2  # s of wall clock per IK query (the iteration bound decides first)
+WORLD_HINT = ("the spots are world coordinates: give them relative to the arm with 'placement: reach' "
+              "(as the built-in task pick_place_reach does)")
 
 
 @dataclass(frozen=True)
@@ -46,13 +48,14 @@ class ReachProblem:
     residual: float
     nominal: bool
     loc: tuple[str | int, ...]
+    hint: str = ""  # what to do about it, appended to the reason
 
     @property
     def reason(self) -> str:
         x, y, z = self.point
         where = "nominal point" if self.nominal else "a corner of its randomisation region"
         return (f"{self.what} is unreachable, out of the arm's reach ({where}, TCP at [{x:.3f}, {y:.3f}, {z:.3f}] m, "
-                f"IK residual {self.residual * 1000:.0f} mm)")
+                f"IK residual {self.residual * 1000:.0f} mm)" + (f"; {self.hint}" if self.hint else ""))
 
     def problem(self, task: CheckedTask) -> Problem:
         return task.doc.problem(self.loc, f"{self.phase}: {self.reason}", "warning")
@@ -86,6 +89,8 @@ def pick_place_reach(task: CheckedTask, arm: str | None = None, params: PickPlac
     suction = isinstance(arm_cfg.gripper, SuctionGripperConfig)
     grip_above_support = centre_above_support + (shape.posed(R0)[:, 2].max() if suction else 0.0)
     scene = task.config.scene
+    given: PickPlaceParams = task.config.pick_place  # type: ignore[union-attr]
+    hint = WORLD_HINT if given.placement == "world" else ""
     out: list[ReachProblem] = []
     spots = [("object", obj.position[:2], params.randomize.object.xy_range, ("pick_place", "object", "position"),
               ("approach", "the grasp pose"), ("pre_grasp", "the pose above the object"), params.above_height),
@@ -100,7 +105,7 @@ def pick_place_reach(task: CheckedTask, arm: str | None = None, params: PickPlac
             for phase, what, height in ((high_phase, high_what, z + rise), (low_phase, low_what, z)):
                 residual = _best_residual(model, arm_cfg, home, np.array([x, y, height]))
                 if residual is not None:
-                    out.append(ReachProblem(phase, what, (x, y, height), residual, nominal, loc))
+                    out.append(ReachProblem(phase, what, (x, y, height), residual, nominal, loc, hint))
                     break  # the first pose the run would fail at (the higher one comes first)
     return out
 
