@@ -151,8 +151,8 @@ def test_collision_rows_match_finite_differences(panda):
     p_world = T[:3, :3] @ p_local + T[:3, 3]
     n = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
     q_full = np.asarray(r.state.q)
-    c._jacobians = {}
-    row = c._normal_row(r.model.getJointId("panda_joint7"), p_world, n, q_full)
+    c.rows.forget_jacobians()
+    row = c.rows.normal_row(r.model.getJointId("panda_joint7"), p_world, n, q_full)
     h = 1e-6
     for k in range(7):
         dq = np.zeros(7)

@@ -7,7 +7,7 @@ regularisation task), respects joint position/velocity/acceleration limits (a ha
 with braking distance, see :mod:`.limits`), and keeps every robot–environment (and non-adjacent
 self) collision pair at least ``margin`` apart with a velocity damper
 ``n·(J_B − J_A)·Δq ≥ −approach_gain·dt·(d − margin) (− n·v_obstacle·dt)`` — placo half-space rows
-filled from coal distances between convex hulls (:mod:`.distances`) inside ``trigger``.
+filled from coal distances between convex hulls inside ``trigger`` (:mod:`.collision_rows`).
 
 Warm start: the QP is linearised at the previous command (not the noisy measurement), so commands
 are continuous; the measured state re-seeds it only after a deviation above ``resync_tolerance``.
@@ -24,18 +24,16 @@ from pathlib import Path
 
 import numpy as np
 
-from robocfg.collision.distances import DistanceField
 from robocfg.collision.shapes import (
     EnvShape,
     LinkGeometry,
     add_environment,
     add_robot_geometry,
     point_clearance,
-    robot_geometry_ids,
-    set_environment_pose,
     to_convex_hulls,
 )
-from robocfg.motion.reactive.escape import Blocking, EscapeRule, EscapeSettings
+from robocfg.motion.reactive.collision_rows import CollisionRows
+from robocfg.motion.reactive.escape import EscapeRule, EscapeSettings
 from robocfg.motion.reactive.limits import step_bounds
 
 CONTINUOUS_RANGE = 1000.0  # rad: limits written on continuous joints for placo (its own joint limits are off)
@@ -161,7 +159,8 @@ class ReactiveController:
         self._q_index = np.array([r.get_joint_offset(j) for j in arm.joint_names])
         self._v_index = np.array([r.get_joint_v_offset(j) for j in arm.joint_names])
         self._set_q(arm.posture)
-        self._select_pairs()
+        self.rows = CollisionRows(r, self.geom, arm, self.env, self.env_ids, settings, self._set_q,
+                                  self._q_index, self._v_index)
 
         s = self.solver = placo.KinematicsSolver(r)
         s.mask_fbase(True)
@@ -183,7 +182,7 @@ class ReactiveController:
         A[self.n + np.arange(self.n), self._q_index] = -1.0
         self.box = s.add_joint_space_half_spaces_constraint(A, np.zeros(2 * self.n))
         self.box.configure("limits", "hard", 1.0)
-        rows = max(len(self.pairs), 1)
+        rows = max(len(self.rows.pairs), 1)
         self.collisions = s.add_joint_space_half_spaces_constraint(np.zeros((rows, nq)), np.ones(rows))
         self.collisions.configure("collisions", "hard", 1.0)
         self.escape = EscapeRule(settings.escape, settings.margin)
@@ -195,8 +194,6 @@ class ReactiveController:
         self.t = 0.0
         self.fallbacks = 0
         self.soft_steps = 0
-        self._jacobians: dict[int, np.ndarray] = {}
-        self._env_velocity: dict[int, np.ndarray] = {}
 
     # -- model ---------------------------------------------------------------------------------
     def _set_q(self, q: np.ndarray) -> None:
@@ -204,72 +201,15 @@ class ReactiveController:
             self.robot.set_joint(name, float(v))
         self.robot.update_kinematics()
 
-    def _select_pairs(self) -> None:
-        """Robot–environment pairs for every moving robot geometry (except pairs with a non-obstacle
-        shape such as the pedestal or table that are already within the margin at the posture: the
-        robot stands on it); self pairs for geometries more than ``2·margin`` apart at the posture
-        (adjacent hulls overlap and are skipped)."""
-        import pinocchio as pin
-
-        g = self.geom
-        g.removeAllCollisionPairs()
-        base_joints = {0, 1}  # universe and placo's floating base: geometry there cannot move
-        robot_ids = robot_geometry_ids(g, base_joints)
-        all_robot = robot_geometry_ids(g, set())
-        for rid in robot_ids:
-            for eid in self.env_ids.values():
-                g.addCollisionPair(pin.CollisionPair(rid, eid))
-        if self.s.self_collision:
-            anc = self._arm_ancestors()
-            for a in all_robot:
-                for b in all_robot:
-                    ja, jb = anc[g.geometryObjects[a].parentJoint], anc[g.geometryObjects[b].parentJoint]
-                    if a < b and ja != jb:  # same arm-joint ancestor: rigid to each other in the QP
-                        g.addCollisionPair(pin.CollisionPair(a, b))
-        self._set_q(self.arm.posture)
-        field = DistanceField(self.robot.model, g)
-        field.update(np.asarray(self.robot.state.q))
-        found, _ = field.query(np.inf)
-        keep, self.support_pairs = [], []
-        for d in found:
-            na, nb = g.geometryObjects[d.a].name, g.geometryObjects[d.b].name
-            if nb.startswith("env:"):
-                if not self.env[nb[4:]].obstacle and d.distance < self.s.margin:
-                    self.support_pairs.append((na, nb[4:]))  # robot resting on/next to it: not avoided
-                    continue
-            elif d.distance <= 2 * self.s.margin:
-                continue  # self pair already close at the posture (adjacent hulls overlap)
-            keep.append((d.a, d.b))
-        g.removeAllCollisionPairs()
-        for a, b in keep:
-            g.addCollisionPair(pin.CollisionPair(a, b))
-        self.pairs = [(p.first, p.second) for p in g.collisionPairs]
-        self._names = [o.name for o in g.geometryObjects]
-        self._env_pair = np.array([self._names[b].startswith("env:") for _, b in self.pairs], dtype=bool)
-        self._obstacle_pair = np.array([self._env_pair[k] and self.env[self._names[b][4:]].obstacle
-                                        for k, (_, b) in enumerate(self.pairs)], dtype=bool)
-        self.field = DistanceField(self.robot.model, g)
-        self._cutoff = np.where(self._env_pair, self.s.trigger, self.s.self_trigger)
-
-    def _arm_ancestors(self) -> list[int]:
-        """For every pinocchio joint, the nearest arm joint at or above it (0 for none): geometry
-        below the same arm joint moves rigidly in the QP (gripper joints are held fixed)."""
-        model = self.robot.model
-        arm_ids = {model.getJointId(n) for n in self.arm.joint_names}
-        out = []
-        for j in range(model.njoints):
-            k = j
-            while k > 0 and k not in arm_ids:
-                k = model.parents[k]
-            out.append(k)
-        return out
-
     def set_obstacle_pose(self, name: str, pose: np.ndarray, velocity: np.ndarray | None = None) -> None:
         """Move environment shape ``name`` to ``pose`` (4×4, world); ``velocity`` (m/s, world) is its
         linear velocity, used so the robot keeps the margin from an approaching obstacle."""
-        self.env[name].pose = np.asarray(pose, float)
-        set_environment_pose(self.geom, self.env_ids[name], pose)
-        self._env_velocity[self.env_ids[name]] = np.zeros(3) if velocity is None else np.asarray(velocity, float)[:3]
+        self.rows.set_obstacle_pose(name, pose, velocity)
+
+    @property
+    def pairs(self) -> list[tuple[int, int]]:
+        """The watched geometry pairs (indices into the collision model), see :mod:`.collision_rows`."""
+        return self.rows.pairs
 
     def tcp_pose(self, q: np.ndarray | None = None) -> np.ndarray:
         """World TCP pose (4×4) at ``q`` (default: the last command)."""
@@ -279,58 +219,7 @@ class ReactiveController:
 
     def distances(self) -> list[tuple[str, str, float]]:
         """(robot geometry, environment/robot geometry, distance m) for every pair, at the model state."""
-        self.field.update(np.asarray(self.robot.state.q))
-        found, _ = self.field.query(np.inf)
-        return [(self._names[d.a], self._names[d.b], d.distance) for d in found]
-
-    def _collision_rows(self) -> tuple[list[Blocking], float]:
-        """Fill the collision half-spaces from the current distances; return the robot–environment
-        pairs inside the trigger distance and the smallest robot–obstacle distance (m)."""
-        A, b = self.collisions.A, self.collisions.b
-        A[:] = 0.0
-        b[:] = 1.0
-        q_full = np.asarray(self.robot.state.q)
-        self.field.update(q_full)
-        found, dist = self.field.query(self._cutoff)
-        clearance = float(dist[self._obstacle_pair].min()) if self._obstacle_pair.any() else float("inf")
-        near: list[Blocking] = []
-        xi = self.s.approach_gain * self.s.dt
-        self._jacobians = {}
-
-        row = 0
-        for d in found:
-            env = self._env_pair[d.pair]
-            if env:
-                near.append(Blocking(d.distance, -d.normal))
-            if d.distance >= (self.s.trigger if env else self.s.self_trigger) or row >= A.shape[0]:
-                continue
-            # d' = n·(v_B − v_A) ≥ −ξ·(d − margin): a velocity damper, n from A (robot) towards B
-            ja, jb = self.geom.geometryObjects[d.a].parentJoint, self.geom.geometryObjects[d.b].parentJoint
-            row_v = -self._normal_row(ja, d.point_a, d.normal, q_full)
-            if jb > 1:
-                row_v = row_v + self._normal_row(jb, d.point_b, d.normal, q_full)
-            A[row, self._q_index] = -row_v
-            b[row] = xi * (d.distance - self.s.margin) + A[row, self._q_index] @ self.q
-            v_b = self._env_velocity.get(d.b)
-            if v_b is not None:  # a moving obstacle: its own approach speed counts against the margin
-                b[row] += float(d.normal @ v_b) * self.s.dt
-            row += 1
-        return near, clearance
-
-    def _normal_row(self, joint: int, p: np.ndarray, n: np.ndarray, q_full: np.ndarray) -> np.ndarray:
-        """``n · J_p`` over the arm joints: the speed along ``n`` of the world point ``p`` fixed to
-        pinocchio joint ``joint``'s body, per unit arm-joint velocity (Jacobians cached per step)."""
-        import pinocchio as pin
-
-        J = self._jacobians.get(joint)
-        if J is None:
-            model, data = self.field.model, self.field.data
-            if not self._jacobians:
-                pin.computeJointJacobians(model, data, q_full)
-            J = self._jacobians[joint] = pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.WORLD)[:, self._v_index]
-        # v_p = v_O + ω × p, so n·v_p = n·v_O + (p × n)·ω
-        pxn = np.array([p[1] * n[2] - p[2] * n[1], p[2] * n[0] - p[0] * n[2], p[0] * n[1] - p[1] * n[0]])
-        return n @ J[:3] + pxn @ J[3:]
+        return self.rows.distances()
 
     # -- control -------------------------------------------------------------------------------
     def reset(self, q: np.ndarray, dq: np.ndarray | None = None, t: float = 0.0) -> None:
@@ -369,7 +258,7 @@ class ReactiveController:
             self.dq[:] = 0.0
         self._set_q(self.q)
         self.t += self.s.dt
-        blocking, clearance = self._collision_rows()
+        blocking, clearance = self.rows.fill(self.collisions.A, self.collisions.b, self.q)
         T_tcp = np.asarray(self.robot.get_T_world_frame(self.arm.ee_link)) @ self.arm.T_ee_tcp
         target = np.asarray(T_target_tcp, float).copy()
         target[:3, 3] = self.escape.update(self.t, T_tcp[:3, 3], target[:3, 3], blocking)
