@@ -13,7 +13,8 @@ closing down to the grasp width, dip below the support (linkages such as the Rob
 forward); (6) score = antipodality, Ferrari–Canny epsilon (gravity torque about the contact axis
 included) and top-down preference; (7) non-maximum suppression; (8) closing knuckles/linkages vs
 the cloud, then IK reachability (a callback) until ``top_k`` survive. Rejections are counted per
-reason (``REASONS``).
+reason (``REASONS``). Steps 1–2 live in :mod:`robocfg.grasp.pairs`, the gripper-box tests of steps
+3, 5 and 8 in :mod:`robocfg.grasp.clearance`.
 """
 
 from __future__ import annotations
@@ -26,15 +27,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from robocfg.geometry import rotation_angle
-from robocfg.grasp.gripper_model import CLOSING_TOLERANCE, GripperBoxes
+from robocfg.grasp.clearance import above_support, closing_clear, collision_free, linkage_clear
+from robocfg.grasp.gripper_model import GripperBoxes
+from robocfg.grasp.pairs import antipodal_pairs, grasp_poses
 from robocfg.grasp.quality import epsilon
 from robocfg.kinematics.frames import Grasp
 
 REASONS = ("not_antipodal", "too_wide", "collision", "slips_at_contact", "linkage_collision", "unreachable")
-APPROACH_ANGLES_DEG = (0.0, 30.0, -30.0, 60.0, -60.0)
-LEVEL_TILT = 0.05  # closing axes steeper than this (sine) also get a level variant
 MIN_CONTACT_POINTS = 4  # cloud points a finger must find at its contact (a patch, not an edge)
-LINKAGE_MARGIN = 0.001  # m: clearance kept between closing knuckles/linkages and the cloud
 MIN_FACING = 0.25  # a finger pad pushes only on points whose normal faces it by more than this (cosine)
 
 
@@ -111,8 +111,9 @@ def plan_grasps(points: np.ndarray, normals: np.ndarray, scene: np.ndarray, supp
     s = settings
     res = PlanResult([], 0, 0)
     w_max = min(boxes.max_width, _finger_gap(boxes)) - 2 * s.clearance
-    pairs = _antipodal_pairs(points, normals, w_max, s, rng, res)
-    centers, rots = _poses(pairs, s)
+    pairs, res.seeds, lonely = antipodal_pairs(points, normals, w_max, s.mu, s.voxel, s.num_candidates, rng)
+    res.rejected["not_antipodal"] += lonely
+    centers, rots = grasp_poses(pairs)
     centers, rots = centers[: s.max_poses], rots[: s.max_poses]
     res.poses = len(centers)
     if not len(centers):
@@ -121,8 +122,8 @@ def plan_grasps(points: np.ndarray, normals: np.ndarray, scene: np.ndarray, supp
     swept = boxes.swept(s.standoff).inflated(s.collision_margin)
     free = np.ones(len(centers), bool)
     if support_z is not None:
-        free &= _above_support(centers, rots, swept, support_z)
-    free[free] = _collision_free(centers[free], rots[free], scene, swept)
+        free &= above_support(centers, rots, swept, support_z)
+    free[free] = collision_free(centers[free], rots[free], scene, swept)
     res.rejected["collision"] += int((~free).sum())
     centers, rots = centers[free], rots[free]
     com = points.mean(axis=0)
@@ -130,7 +131,7 @@ def plan_grasps(points: np.ndarray, normals: np.ndarray, scene: np.ndarray, supp
     curv = np.zeros(len(points)) if curvature is None else np.asarray(curvature, float)
     cands = _closing_check(centers, rots, points, normals, curv, boxes, w_max, s, res)
     if support_z is not None and boxes.samples:
-        clear = _closing_clear(cands, boxes, s, support_z)
+        clear = closing_clear([c.grasp for c in cands], boxes, s.collision_margin, support_z)
         res.rejected["collision"] += int((~clear).sum())
         cands = [c for c, ok in zip(cands, clear, strict=True) if ok]
     cands.sort(key=lambda c: -c.score)
@@ -148,7 +149,7 @@ def plan_grasps(points: np.ndarray, normals: np.ndarray, scene: np.ndarray, supp
         if any(_duplicate(c.grasp, k.grasp, s) for k in kept):
             res.suppressed += 1
             continue
-        if not _linkage_clear(c, boxes, scene):
+        if not linkage_clear(c.grasp, boxes, scene):
             res.rejected["linkage_collision"] += 1
             continue
         if reach is not None:
@@ -173,119 +174,6 @@ def _finger_gap(boxes: GripperBoxes) -> float:
     if len(pos) and len(neg):
         return float(pos.min() - neg.max())
     return boxes.max_width
-
-
-def _antipodal_pairs(P, N, w_max, s: PlannerSettings, rng, res: PlanResult, chunk: int = 64) -> list[tuple[np.ndarray, np.ndarray]]:
-    """For each seed point: its most antipodal partner and one random antipodal partner within
-    ``w_max`` (both contact normals within the friction cone of the contact line)."""
-    n = len(P)
-    cos_cone = math.cos(math.atan(s.mu))
-    seeds = rng.choice(n, size=min(s.num_candidates, n), replace=False)
-    res.seeds = len(seeds)
-    out: list[tuple[np.ndarray, np.ndarray]] = []
-    for a in range(0, len(seeds), chunk):
-        S = seeds[a : a + chunk]
-        D = P[None, :, :] - P[S][:, None, :]  # (k, n, 3)
-        dist = np.linalg.norm(D, axis=2)
-        U = D / np.maximum(dist, 1e-12)[:, :, None]
-        c1 = -np.einsum("kni,ki->kn", U, N[S])
-        c2 = np.einsum("kni,ni->kn", U, N)
-        good = (dist > 2 * s.voxel) & (dist <= w_max) & (c1 >= cos_cone) & (c2 >= cos_cone)
-        quality = np.where(good, np.minimum(c1, c2), -np.inf)
-        for r, i in enumerate(S):
-            g = np.flatnonzero(good[r])
-            if len(g) == 0:
-                res.rejected["not_antipodal"] += 1
-                continue
-            for j in {int(np.argmax(quality[r])), int(rng.choice(g))}:
-                _add_pair(out, P[i], P[j])
-    return out
-
-
-def _add_pair(out: list, a: np.ndarray, b: np.ndarray) -> None:
-    out.append((a, b))
-    u = b - a
-    if abs(u[2]) > LEVEL_TILT * np.linalg.norm(u) and np.linalg.norm(u[:2]) > 1e-6:
-        # the same centre with a level closing axis: on round objects (any diameter is antipodal)
-        # it keeps both fingers off the support; the closing check re-measures it
-        c, h = (a + b) / 2, np.linalg.norm(u) / 2
-        lev = np.array([u[0], u[1], 0.0]) / np.linalg.norm(u[:2])
-        out.append((c - h * lev, c + h * lev))
-
-
-def _poses(pairs, s: PlannerSettings) -> tuple[np.ndarray, np.ndarray]:
-    """Centres (K, 3) and rotations (K, 3, 3): every pair × ``APPROACH_ANGLES_DEG`` about its axis,
-    angle 0 being the approach closest to straight down."""
-    if not pairs:
-        return np.zeros((0, 3)), np.zeros((0, 3, 3))
-    p1 = np.array([a for a, _ in pairs])
-    p2 = np.array([b for _, b in pairs])
-    y = p2 - p1
-    y /= np.linalg.norm(y, axis=1, keepdims=True)
-    down = np.array([0.0, 0.0, -1.0])
-    e1 = down - (y @ down)[:, None] * y
-    flat = np.linalg.norm(e1, axis=1) < 1e-3  # vertical closing axis: approach horizontally
-    e1[flat] = np.cross(y[flat], [1.0, 0.0, 0.0])
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-    e2 = np.cross(y, e1)
-    c = (p1 + p2) / 2
-    t = np.radians(APPROACH_ANGLES_DEG)
-    a = np.cos(t)[None, :, None] * e1[:, None, :] + np.sin(t)[None, :, None] * e2[:, None, :]  # (K, A, 3)
-    yy = np.broadcast_to(y[:, None, :], a.shape)
-    R = np.stack([a, yy, np.cross(a, yy)], axis=-1).reshape(-1, 3, 3)
-    C = np.repeat(c, len(t), axis=0)
-    return C, R
-
-
-def _above_support(centers, rots, boxes: GripperBoxes, support_z: float) -> np.ndarray:
-    """True where every corner of every box stays above the support plane z = ``support_z``."""
-    lo, hi = boxes.lo, boxes.hi
-    corners = np.stack([np.where(np.array(bits)[None, :], hi, lo) for bits in np.ndindex(2, 2, 2)], axis=1)  # (B, 8, 3)
-    z = np.einsum("bcj,kj->kbc", corners, rots[:, 2, :]) + centers[:, 2, None, None]  # world z of each corner
-    return np.all(z > support_z, axis=(1, 2))
-
-
-def _closing_clear(cands: list[Candidate], boxes: GripperBoxes, s: PlannerSettings, support_z: float) -> np.ndarray:
-    """True where every link, the fingers closing from open down to the candidate's width, stays
-    above the support plane (box corners)."""
-    ok = np.ones(len(cands), bool)
-    if not cands or not boxes.samples:
-        return ok
-    widths = np.array([c.grasp.width for c in cands])
-    C = np.array([c.grasp.center for c in cands])
-    R = np.array([c.grasp.rotation for c in cands])
-    gaps = sorted({s.gap for s in boxes.samples}, reverse=True)
-    # group by how far the fingers close: the number of samples at least as wide as the grasp
-    reach = np.array([sum(g >= w - CLOSING_TOLERANCE for g in gaps) for w in widths])
-    for n in np.unique(reach):
-        idx = np.flatnonzero(reach == n)
-        sweep = boxes.closing_sweep(gaps[n - 1] if n > 0 else boxes.max_width + 1.0)
-        ok[idx] &= _above_support(C[idx], R[idx], sweep.inflated(s.collision_margin), support_z)
-    return ok
-
-
-def _linkage_clear(c: Candidate, boxes: GripperBoxes, scene: np.ndarray) -> bool:
-    """The closing knuckles and linkages (oriented boxes per measured opening) miss the cloud."""
-    if not boxes.samples or len(scene) == 0:
-        return True
-    g = c.grasp
-    near = np.linalg.norm(scene - g.center, axis=1) < 0.25
-    return not boxes.linkage_hits((scene[near] - g.center) @ g.rotation, g.width, LINKAGE_MARGIN)
-
-
-def _collision_free(centers, rots, scene, boxes: GripperBoxes, chunk: int = 128) -> np.ndarray:
-    """True where no scene point lies inside any of the (swept, inflated) gripper boxes."""
-    free = np.ones(len(centers), bool)
-    if len(scene) == 0:
-        return free
-    for a in range(0, len(centers), chunk):
-        C, R = centers[a : a + chunk], rots[a : a + chunk]
-        local = (scene[None, :, :] - C[:, None, :]) @ R  # (k, S, 3) in each grasp frame
-        hit = np.zeros(len(C), bool)
-        for lo, hi in zip(boxes.lo, boxes.hi, strict=True):
-            hit |= np.any(np.all((local >= lo) & (local <= hi), axis=2), axis=1)
-        free[a : a + chunk] = ~hit
-    return free
 
 
 def _closing_check(centers, rots, P, N, curv, boxes: GripperBoxes, w_max, s: PlannerSettings,
