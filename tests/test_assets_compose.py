@@ -10,7 +10,7 @@ import pytest
 
 from robocfg.assets.compose import CompositionError, Part, compose
 from robocfg.assets.paths import Resolver
-from robocfg.assets.urdf import parse_urdf
+from robocfg.assets.urdf_xml import parse_urdf
 from robocfg.checks import load_robot
 from robocfg.errors import ConfigError
 from robocfg.geometry import rpy_matrix

@@ -24,7 +24,7 @@ def test_planners_do_not_load_pybullet() -> None:
 
 
 def test_config_and_urdf_parsing_do_not_load_scipy_or_simulators() -> None:
-    mods = ["robocfg.config.robot", "robocfg.config.task", "robocfg.config.types", "robocfg.assets.urdf",
+    mods = ["robocfg.config.robot", "robocfg.config.task", "robocfg.config.types", "robocfg.assets.urdf", "robocfg.assets.urdf_xml",
             "robocfg.geometry"]
     assert _loaded_after(mods, ["scipy", "pybullet", "pinocchio", "placo"]) == []
 

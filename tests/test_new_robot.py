@@ -11,7 +11,7 @@ import yaml
 from _cli import run_main
 
 from robocfg.assets.draft import draft_robot, render_yaml
-from robocfg.assets.urdf import parse_urdf
+from robocfg.assets.urdf_xml import parse_urdf
 from robocfg.checks import load_robot
 
 ROOT = Path(__file__).resolve().parent.parent

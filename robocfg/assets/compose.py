@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import read_urdf_xml
+from robocfg.assets.urdf_xml import read_urdf_xml
 from robocfg.suggest import did_you_mean
 
 COMPOSER_VERSION = "1"

@@ -158,7 +158,7 @@ def draft_composed(source: Path, src: RobotSource, name: str, out_dir: Path) -> 
     the geometry comes from the composed URDF, the draft keeps the parts (paths rebased on
     ``out_dir``). Raises UnresolvedPath or CompositionError for missing or clashing parts."""
     from robocfg.assets.compose import Part, compose, rpy_from_deg
-    from robocfg.assets.urdf import parse_urdf
+    from robocfg.assets.urdf_xml import parse_urdf
 
     resolver = Resolver(source.parent, src.package_dirs)
     base = resolver.urdf(src.urdf)

@@ -27,7 +27,8 @@ import numpy as np
 import trimesh
 
 from robocfg.assets.paths import body_asset
-from robocfg.assets.urdf import Geometry, parse_urdf, read_urdf_xml
+from robocfg.assets.urdf import Geometry
+from robocfg.assets.urdf_xml import parse_urdf, read_urdf_xml
 from robocfg.config.scene import Body
 from robocfg.geometry import rpy_matrix
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass, parse_urdf
+from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass
+from robocfg.assets.urdf_xml import parse_urdf
 from robocfg.checks.arm import Collector, check_arm, known
 from robocfg.config.load import YamlDocument, load_yaml
 from robocfg.config.robot import ArmConfig, ParallelGripperConfig, RobotConfig

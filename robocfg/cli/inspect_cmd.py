@@ -20,7 +20,8 @@ def inspect(
     from rich.table import Table
 
     from robocfg.assets.inspection import inspect_urdf
-    from robocfg.assets.urdf import UrdfParseError, parse_urdf
+    from robocfg.assets.urdf import UrdfParseError
+    from robocfg.assets.urdf_xml import parse_urdf
     from robocfg.checks import load_robot
     from robocfg.config import catalog
     from robocfg.errors import ConfigError

@@ -70,7 +70,8 @@ def _draft(source: Path, name: str, out_dir: Path):
     from robocfg.assets.compose import CompositionError
     from robocfg.assets.draft import draft_composed, draft_robot
     from robocfg.assets.paths import UnresolvedPath
-    from robocfg.assets.urdf import UrdfParseError, parse_urdf
+    from robocfg.assets.urdf import UrdfParseError
+    from robocfg.assets.urdf_xml import parse_urdf
     from robocfg.config.load import load_yaml
     from robocfg.config.robot import RobotSource
     from robocfg.config.validation import validate_document

@@ -24,7 +24,8 @@ from robocfg.assets.compose import CompositionError, Part, compose, rpy_from_deg
 from robocfg.assets.draft import _uri
 from robocfg.assets.draft_gripper import UnsupportedGripper, parallel_gripper
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass, parse_urdf
+from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass
+from robocfg.assets.urdf_xml import parse_urdf
 from robocfg.checks import CheckedRobot, load_robot
 from robocfg.config.load import Loc, YamlDocument, format_loc, load_yaml
 from robocfg.config.robot import Attachment

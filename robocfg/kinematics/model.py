@@ -42,7 +42,7 @@ def _urdf_xml_without_continuous(path: str) -> tuple[str, set[str]]:
     pinocchio models continuous joints with two coordinates (cos, sin); one angle per joint keeps
     the interface simple. Returns (xml text, names of the converted joints).
     """
-    from robocfg.assets.urdf import read_urdf_xml
+    from robocfg.assets.urdf_xml import read_urdf_xml
 
     root = read_urdf_xml(path)
     converted: set[str] = set()

@@ -24,7 +24,8 @@ from pathlib import Path
 import pybullet as p
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
-from robocfg.assets.urdf import FRAME_LINK_MASS, missing_link_mass, read_urdf_xml
+from robocfg.assets.urdf import FRAME_LINK_MASS, missing_link_mass
+from robocfg.assets.urdf_xml import read_urdf_xml
 from robocfg.checks.robot import CheckedRobot
 from robocfg.errors import ConfigError
 from robocfg.sim.quiet import captured_stdout
