@@ -186,3 +186,21 @@ def _depth_first(root: str, joints: list[Joint]) -> list[Joint]:
 
     visit(root)
     return out
+
+
+def revolute_continuous(root: ET.Element, limit: float) -> set[str]:
+    """Turn the continuous joints of the URDF ``root`` into revolute ones limited to
+    [-``limit``, ``limit``] (rad), in place (a ``<limit>`` without effort or velocity is added
+    where there is none). Returns the names of the converted joints."""
+    converted: set[str] = set()
+    for j in root.iter("joint"):
+        if j.get("type") != "continuous":
+            continue
+        j.set("type", "revolute")
+        lim = j.find("limit")
+        if lim is None:
+            lim = ET.SubElement(j, "limit", effort="0", velocity="0")
+        lim.set("lower", repr(-limit))
+        lim.set("upper", repr(limit))
+        converted.add(j.get("name", ""))
+    return converted

@@ -42,22 +42,10 @@ def _urdf_xml_without_continuous(path: str) -> tuple[str, set[str]]:
     pinocchio models continuous joints with two coordinates (cos, sin); one angle per joint keeps
     the interface simple. Returns (xml text, names of the converted joints).
     """
-    from robocfg.assets.urdf_xml import read_urdf_xml
+    from robocfg.assets.urdf_xml import read_urdf_xml, revolute_continuous
 
     root = read_urdf_xml(path)
-    converted: set[str] = set()
-    for j in root.iter("joint"):
-        if j.get("type") != "continuous":
-            continue
-        j.set("type", "revolute")
-        lim = j.find("limit")
-        if lim is None:
-            lim = ET.SubElement(j, "limit")
-            lim.set("effort", "0")
-            lim.set("velocity", "0")
-        lim.set("lower", repr(-math.pi))
-        lim.set("upper", repr(math.pi))
-        converted.add(j.get("name", ""))
+    converted = revolute_continuous(root, math.pi)
     return ET.tostring(root, encoding="unicode"), converted
 
 

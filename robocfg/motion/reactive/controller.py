@@ -96,6 +96,8 @@ def _urdf_without_geometry(path: Path) -> str:
     a continuous joint are infinite), so a joint that turns past ±π keeps turning smoothly."""
     import xml.etree.ElementTree as ET
 
+    from robocfg.assets.urdf_xml import revolute_continuous
+
     root = ET.parse(path).getroot()
     for link in root.iter("link"):
         for tag in ("visual", "collision"):
@@ -105,13 +107,7 @@ def _urdf_without_geometry(path: Path) -> str:
     for joint in root.iter("joint"):
         if joint.get("type") == "fixed" and joint.get("name") in links:  # placo cannot tell a link from a joint of the same name
             joint.set("name", f"{joint.get('name')}__fixed_joint")
-        if joint.get("type") == "continuous":
-            joint.set("type", "revolute")
-            limit = joint.find("limit")
-            if limit is None:
-                limit = ET.SubElement(joint, "limit", effort="0", velocity="0")
-            limit.set("lower", repr(-CONTINUOUS_RANGE))
-            limit.set("upper", repr(CONTINUOUS_RANGE))
+    revolute_continuous(root, CONTINUOUS_RANGE)
     return ET.tostring(root, encoding="unicode")
 
 
