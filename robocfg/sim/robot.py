@@ -12,6 +12,10 @@ Position drives (``command_positions``): PyBullet's ``POSITION_CONTROL`` motor m
 ≈ the fraction of the position error removed per step, 0.01–1), ``damping → velocityGain``
 (dimensionless, 1.0 = fully track the target velocity) and ``max_force → force`` (N·m for
 revolute, N for prismatic joints). These are *not* PhysX stiffness/damping in N·m/rad.
+
+Length (≈ 300 lines): one concept, the robot's name-to-index maps and everything that reads or
+writes through them (joints, drives, link poses, self-collision query); ``ArmHandle`` is a thin
+view of one arm over the same maps. Splitting it would pass the maps around for no gain.
 """
 
 from __future__ import annotations
