@@ -80,7 +80,20 @@ def _lower_support(run: GripperRun, support: Body) -> None:
     run.run_for(SUPPORT_LOWER_TIME, each=lower)
 
 
+def _support_away(run: GripperRun, hold: HoldTest, support: Body, z0: float) -> None:
+    """Lower (or remove) the support, wait ``HOLD_WAIT``, and record in ``hold`` how far the object
+    sank below ``z0`` (its centre's height when gripped, m) and whether it is still gripped."""
+    _lower_support(run, support)
+    run.phase("hold")
+    run.run_for(HOLD_WAIT)
+    hold.drop = float(z0 - run.world.body_pose(hold.object)[0][2])
+    hold.grasping_after = run.gripper.is_grasping(hold.object)
+    hold.held = hold.grasping_after and hold.drop < HOLD_DROP_MAX
+
+
 def hold_test(run: GripperRun) -> None:
+    """Parallel (and one-jaw) grippers: the object is placed between the open fingers, gripped,
+    the support lowered, then released."""
     w, g, res = run.world, run.gripper, run.result
     tcp = run.arm.tcp_pose()
     name, support = _place_object(run, _grasp_centre(run, tcp), run.arm.ee_pose()[:3, :3])
@@ -93,12 +106,7 @@ def hold_test(run: GripperRun) -> None:
     res.hold = hold
     if not grasp_before:
         raise RunFailed("grasp", f"the fingers do not both touch {name!r} after closing (width {_mm(width_on)})")
-    _lower_support(run, support)
-    run.phase("hold")
-    run.run_for(HOLD_WAIT)
-    hold.drop = float(z0 - w.body_pose(name)[0][2])
-    hold.grasping_after = g.is_grasping(name)
-    hold.held = hold.grasping_after and hold.drop < HOLD_DROP_MAX
+    _support_away(run, hold, support, z0)
     if not hold.held:
         raise RunFailed("hold", f"{name!r} was not held: it sank {hold.drop * 1000:.1f} mm "
                                 f"(limit {HOLD_DROP_MAX * 1000:.0f} mm), fingers touching: {hold.grasping_after}")
@@ -127,12 +135,7 @@ def suction_test(run: GripperRun) -> None:
     res.hold = hold
     if not hold.grasping_before:
         raise RunFailed("grasp", f"suction did not attach {name!r}")
-    _lower_support(run, support)
-    run.phase("hold")
-    run.run_for(HOLD_WAIT)
-    hold.drop = float(z0 - w.body_pose(name)[0][2])
-    hold.grasping_after = g.is_grasping(name)
-    hold.held = hold.grasping_after and hold.drop < HOLD_DROP_MAX
+    _support_away(run, hold, support, z0)
     if not hold.held:
         raise RunFailed("hold", f"{name!r} was not held (sank {hold.drop * 1000:.1f} mm)")
     run.move("release", 0, g.off)

@@ -99,10 +99,12 @@ Descend = Callable[[np.ndarray, float, "int | None"], tuple[bool, int, float, np
 
 def search(km: KinematicModel, descend: Descend, q0: np.ndarray, deadline: float,
            rng: np.random.Generator | None, clock: Callable[[], float] | None = None,
-           max_total_iter: int | None = None) -> tuple[np.ndarray, int, int]:
+           max_total_iter: int | None = None,
+           restart: Callable[[np.random.Generator], np.ndarray] | None = None) -> tuple[np.ndarray, int, int]:
     """Run ``descend(q, deadline, cap) -> (converged, iterations, score, q)`` from ``q0``, then from
-    uniform random configurations, until one converges, the deadline passes or
-    ``max_total_iter`` iterations have been spent (``cap``: the iterations left, None: no cap).
+    restart configurations (``restart(rng)``; default: uniform within the limits), until one
+    converges, the deadline passes or ``max_total_iter`` iterations have been spent (``cap``: the
+    iterations left, None: no cap). ``rng`` None: ``default_rng(0)``.
 
     ``deadline`` is on ``clock`` (default ``time.perf_counter``).
     Returns (best q by score, total iterations, restarts).
@@ -124,7 +126,7 @@ def search(km: KinematicModel, descend: Descend, q0: np.ndarray, deadline: float
         restarts += 1
         if rng is None:
             rng = np.random.default_rng(0)
-        q = rng.uniform(km.lower, km.upper)
+        q = rng.uniform(km.lower, km.upper) if restart is None else restart(rng)
 
 
 def finish(km: KinematicModel, backend: str, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool,

@@ -29,6 +29,7 @@ from robocfg.kinematics.ik.common import (
     finish,
     nearest_equivalent,
     prepare,
+    search,
 )
 from robocfg.kinematics.ik.registry import register
 
@@ -68,22 +69,13 @@ class LMSolver:
         t0 = perf_counter()
         km = self.km
         _, q0, fid, Mt = prepare(km, target, seed_q, frame)
-        q = q0
         deadline = self.clock() + time_budget
-        best_s, best_q = math.inf, q
-        iters = restarts = 0
-        while True:
-            cap = self.max_iter if self.max_total_iter is None else min(self.max_iter, self.max_total_iter - iters)
-            ok, it, s, q_end = self._descend(q, Mt, fid, position_only, deadline, cap)
-            iters += it
-            if s < best_s:
-                best_s, best_q = s, q_end
-            if ok or self.clock() >= deadline or (self.max_total_iter is not None and iters >= self.max_total_iter):
-                break
-            restarts += 1
-            if rng is None:
-                rng = np.random.default_rng(0)
-            q = self._restart(rng, Mt, fid, position_only)
+
+        def descend(q: np.ndarray, deadline: float, cap: int | None) -> tuple[bool, int, float, np.ndarray]:
+            return self._descend(q, Mt, fid, position_only, deadline, self.max_iter if cap is None else min(self.max_iter, cap))
+
+        best_q, iters, restarts = search(km, descend, q0, deadline, rng, self.clock, self.max_total_iter,
+                                         lambda rng: self._restart(rng, Mt, fid, position_only))
         return finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only,
                       self.tol_pos, self.tol_rot, t0, iters, restarts)
 
