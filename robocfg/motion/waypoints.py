@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,14 +28,17 @@ from robocfg.errors import ConfigError, Problem, RunFailed
 from robocfg.geometry import pose_matrix
 from robocfg.motion.limits import JointLimits
 
+if TYPE_CHECKING:
+    from robocfg.kinematics.ik.result import IKResult
+
 IK_POS_TOL = 1e-3  # m
 IK_ROT_TOL = 1e-2  # rad
 IK_JUMP_WARN = 1.5  # rad: an IK answer this far from the previous waypoint (one joint) earns a warning
 
 # problem(loc, message) -> Problem, loc relative to the waypoint list, e.g. (2, "panda_joint4")
 ProblemFn = Callable[[tuple, str], Problem]
-# ik(world_T_tcp 4x4, seed q) -> an IKResult-like object (q, converged, pos_err, rot_err)
-IKFn = Callable[[np.ndarray, np.ndarray], object]
+# ik(world_T_tcp 4x4, seed q) -> the IK answer (q, converged, pos_err m, rot_err rad)
+IKFn = Callable[[np.ndarray, np.ndarray], "IKResult"]
 
 
 @dataclass
@@ -65,17 +69,17 @@ def resolve_waypoints(items: list, limits: JointLimits, home: np.ndarray, proble
                 problems.append(problem((i,), "Cartesian waypoints need a kinematic model (none available)"))
             elif not problems:
                 res = ik(pose_matrix(item), prev)
-                ok = bool(res.converged) and res.pos_err <= IK_POS_TOL and res.rot_err <= IK_ROT_TOL  # type: ignore[attr-defined]
+                ok = bool(res.converged) and res.pos_err <= IK_POS_TOL and res.rot_err <= IK_ROT_TOL
                 if not ok:
                     raise RunFailed("waypoints", f"waypoint {i} (TCP pose at {list(item.position)} m) is unreachable: "
-                                    f"IK residual {res.pos_err * 1000:.1f} mm, {np.degrees(res.rot_err):.1f}°")  # type: ignore[attr-defined]
-                q = np.asarray(res.q, dtype=float)  # type: ignore[attr-defined]
+                                    f"IK residual {res.pos_err * 1000:.1f} mm, {np.degrees(res.rot_err):.1f}°")
+                q = np.asarray(res.q, dtype=float)
                 jump = np.abs(q - prev)
                 if jump.max() > IK_JUMP_WARN:
                     k = int(np.argmax(jump))
                     warnings.append(f"waypoint {i}: the IK answer moves {limits.names[k]} by {jump[k]:.2f} rad from the "
                                     "previous waypoint (another IK branch?); add an intermediate waypoint if that is not intended")
-                ik_errors[i] = (float(res.pos_err), float(res.rot_err))  # type: ignore[attr-defined]
+                ik_errors[i] = (float(res.pos_err), float(res.rot_err))
                 check_within(i, q, position_limits, "pose", problem, problems)
         else:
             kind, q = joint_waypoint(i, item, position_limits, home, prev, problem, problems)
