@@ -129,6 +129,33 @@ def search(km: KinematicModel, descend: Descend, q0: np.ndarray, deadline: float
         q = rng.uniform(km.lower, km.upper) if restart is None else restart(rng)
 
 
+class Descent:
+    """The bookkeeping of one descent, step by step: the best configuration so far by error
+    ``s = position error + rotation error`` (m + rad), convergence (both errors within
+    ``tol_pos``/``tol_rot``), and stalls (``stall_n`` steps in a row without ``s`` dropping below
+    ``stall_ratio`` times its last reference value)."""
+
+    def __init__(self, q0: np.ndarray, tol_pos: float, tol_rot: float, stall_ratio: float, stall_n: int):
+        self.tol_pos, self.tol_rot, self.stall_ratio, self.stall_n = tol_pos, tol_rot, stall_ratio, stall_n
+        self.best_s, self.best_q, self.ref_s, self.stall = math.inf, q0, math.inf, 0
+
+    def step(self, q: np.ndarray, pe: float, re: float) -> bool | None:
+        """Record the configuration ``q`` with errors ``pe`` (m) and ``re`` (rad): True when it
+        converged, False when the descent has stalled, None to go on."""
+        s = pe + re
+        if s < self.best_s:
+            self.best_s, self.best_q = s, q
+        if pe <= self.tol_pos and re <= self.tol_rot:
+            return True
+        if s < self.ref_s * self.stall_ratio:
+            self.ref_s, self.stall = s, 0
+        else:
+            self.stall += 1
+            if self.stall >= self.stall_n:
+                return False
+        return None
+
+
 def finish(km: KinematicModel, backend: str, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool,
            tol_pos: float, tol_rot: float, t0: float, iters: int, restarts: int) -> IKResult:
     """The IKResult for ``q``: residuals by FK (m, rad), convergence against the tolerances."""

@@ -11,13 +11,13 @@ pink is imported when the solver is built.
 
 from __future__ import annotations
 
-import math
 from time import perf_counter
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robocfg.kinematics.ik.common import (
+    Descent,
     finish,
     nearest_equivalent,
     prepare,
@@ -78,30 +78,22 @@ class PinkSolver:
 
         km = self.km
         conf = Configuration(km.model, km.data, q.copy(), copy_data=False)
-        best_s, best_q, ref_s, stall = math.inf, q, math.inf, 0
+        track = Descent(q, self.tol_pos, self.tol_rot, self.stall_ratio, self.stall_n)
         max_iter = self.max_iter if cap is None else min(self.max_iter, cap)
         for it in range(1, max_iter + 1):
             d = conf.data.oMf[fid].actInv(Mt)
             pe = float(np.linalg.norm(d.translation))
             re = 0.0 if position_only else float(np.linalg.norm(pin.log3(d.rotation)))
-            s = pe + re
-            if s < best_s:
-                best_s, best_q = s, conf.q.copy()
-            if pe <= self.tol_pos and re <= self.tol_rot:
-                return True, it, s, best_q
-            if s < ref_s * self.stall_ratio:
-                ref_s, stall = s, 0
-            else:
-                stall += 1
-                if stall >= self.stall_n:
-                    return False, it, best_s, best_q
-            if self.clock() >= deadline:
-                return False, it, best_s, best_q
+            done = track.step(conf.q.copy(), pe, re)
+            if done is True:
+                return True, it, pe + re, track.best_q
+            if done is False or self.clock() >= deadline:
+                return False, it, track.best_s, track.best_q
             tasks = [task, posture] if (pe > 1e-3 or re > 1e-2) else [task]
             try:
                 v = solve_ik(conf, tasks, self.dt, solver="daqp", limits=self.limits, safety_break=False)
             except NoSolutionFound:  # infeasible QP: end this descent
-                return False, it, best_s, best_q
+                return False, it, track.best_s, track.best_q
             conf.integrate_inplace(v, self.dt)
             conf.update()
-        return False, max_iter, best_s, best_q
+        return False, max_iter, track.best_s, track.best_q

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from robocfg.kinematics.ik.common import (
+    Descent,
     finish,
     nearest_equivalent,
     prepare,
@@ -242,7 +243,7 @@ class PlacoSolver:
 
         km = self.km
         self._set_q(q)
-        best_s, best_q, ref_s, stall = math.inf, q, math.inf, 0
+        track = Descent(q, self.tol_pos, self.tol_rot, self.stall_ratio, self.stall_n)
         max_iter = max_iter or self.max_iter
         for it in range(1, max_iter + 1):
             qc = km.lower + np.clip(self._get_q() - km.lower, 0.0, km.upper - km.lower)
@@ -250,24 +251,15 @@ class PlacoSolver:
             d = pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)
             pe = float(np.linalg.norm(d.translation))
             re = 0.0 if position_only else float(np.linalg.norm(pin.log3(d.rotation)))
-            s = pe + re
             # with the constraint on, penetrating configurations are neither answers nor stalls
-            if self._avoid is None or not self.collides(qc):
-                if s < best_s:
-                    best_s, best_q = s, qc
-                if pe <= self.tol_pos and re <= self.tol_rot:
-                    return True, it, s, qc
-                if s < ref_s * self.stall_ratio:
-                    ref_s, stall = s, 0
-                else:
-                    stall += 1
-                    if stall >= self.stall_n:
-                        return False, it, best_s, best_q
-            if self.clock() >= deadline:
-                return False, it, best_s, best_q
+            done = track.step(qc, pe, re) if self._avoid is None or not self.collides(qc) else None
+            if done is True:
+                return True, it, pe + re, qc
+            if done is False or self.clock() >= deadline:
+                return False, it, track.best_s, track.best_q
             try:
                 self.solver.solve(True)
             except RuntimeError:  # placo raises RuntimeError when its QP is infeasible
-                return False, it, best_s, best_q
+                return False, it, track.best_s, track.best_q
             self.robot.update_kinematics()
-        return False, max_iter, best_s, best_q
+        return False, max_iter, track.best_s, track.best_q
