@@ -26,10 +26,14 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf_xml import read_urdf_xml
 from robocfg.suggest import did_you_mean
+
+if TYPE_CHECKING:
+    from robocfg.config.robot import Attachment
 
 COMPOSER_VERSION = "1"
 UNDECLARED_NS = "urn:robocfg:undeclared:"
@@ -49,6 +53,14 @@ class Part:
     @property
     def label(self) -> str:
         return self.name or re.sub(r"[^A-Za-z0-9_\-]", "_", self.urdf_path.stem)
+
+    @classmethod
+    def of(cls, attachment: Attachment, urdf_path: Path) -> Part:
+        """The part of a robot YAML's ``attachments`` entry whose URDF resolved to ``urdf_path``
+        (mount angles converted from degrees)."""
+        x, y, z = attachment.mount_xyz
+        return cls(urdf_path, attachment.mount_link, (x, y, z), rpy_from_deg(attachment.mount_rpy_deg),
+                   attachment.name, attachment.prefix)
 
 
 @dataclass(frozen=True)

@@ -157,13 +157,12 @@ def draft_composed(source: Path, src: RobotSource, name: str, out_dir: Path) -> 
     """Draft a robot given as ``urdf`` + ``attachments`` (a ``RobotSource`` read from ``source``):
     the geometry comes from the composed URDF, the draft keeps the parts (paths rebased on
     ``out_dir``). Raises UnresolvedPath or CompositionError for missing or clashing parts."""
-    from robocfg.assets.compose import Part, compose, rpy_from_deg
+    from robocfg.assets.compose import Part, compose
     from robocfg.assets.urdf_xml import parse_urdf
 
     resolver = Resolver(source.parent, src.package_dirs)
     base = resolver.urdf(src.urdf)
-    parts = [Part(resolver.urdf(a.urdf), a.mount_link, (a.mount_xyz[0], a.mount_xyz[1], a.mount_xyz[2]),
-                  rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix) for a in src.attachments]
+    parts = [Part.of(a, resolver.urdf(a.urdf)) for a in src.attachments]
     composed = compose(base, parts, resolver).path
     d = draft_robot(parse_urdf(composed), name, out_dir, urdf_uri=_rebase(src.urdf, source.parent, out_dir))
     d.attachments = [AttachmentDraft(_rebase(a.urdf, source.parent, out_dir), a.mount_link, list(a.mount_xyz),

@@ -125,7 +125,7 @@ def _load_robot(path: Path, strict: bool) -> CheckedRobot:
 
 def _compose(doc: YamlDocument, config: RobotConfig, resolver: Resolver, base: Path) -> Path:
     """Compose the URDF with ``attachments`` (cached file); ConfigError at the attachment's lines."""
-    from robocfg.assets.compose import CompositionError, Part, compose, rpy_from_deg
+    from robocfg.assets.compose import CompositionError, Part, compose
 
     parts, problems = [], []
     for i, a in enumerate(config.attachments):
@@ -134,8 +134,7 @@ def _compose(doc: YamlDocument, config: RobotConfig, resolver: Resolver, base: P
         except UnresolvedPath as exc:
             problems.append(doc.problem(("attachments", i, "urdf"), f"URDF not found: {exc}"))
             continue
-        x, y, z = a.mount_xyz
-        parts.append((i, Part(path, a.mount_link, (x, y, z), rpy_from_deg(a.mount_rpy_deg), a.name, a.prefix)))
+        parts.append((i, Part.of(a, path)))
     if problems:
         raise ConfigError(problems)
     try:

@@ -20,7 +20,7 @@ from typing import Any
 
 import yaml
 
-from robocfg.assets.compose import CompositionError, Part, compose, rpy_from_deg
+from robocfg.assets.compose import CompositionError, Part, compose
 from robocfg.assets.draft import _uri
 from robocfg.assets.draft_gripper import UnsupportedGripper, parallel_gripper
 from robocfg.assets.paths import Resolver, UnresolvedPath
@@ -104,8 +104,7 @@ def _parse(doc: YamlDocument, uri: str, attachments: list[Any], package_dirs: di
                     att = Attachment.model_validate(a)
                 except ValueError as exc:
                     raise ConfigError([doc.problem((BLOCK_KEY, "attachments", i), f"not an attachment: {exc}")]) from None
-                parts.append(Part(resolver.urdf(att.urdf), att.mount_link, tuple(att.mount_xyz),  # type: ignore[arg-type]
-                                  rpy_from_deg(att.mount_rpy_deg), att.name, att.prefix))
+                parts.append(Part.of(att, resolver.urdf(att.urdf)))
             path = compose(path, parts, resolver).path
         return parse_urdf(path)
     except UnresolvedPath as exc:
