@@ -165,6 +165,7 @@ def test_unknown_command_arguments_exit_2_without_traceback():
 
 def test_debug_shows_traceback(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
+    monkeypatch.setenv("ROBOCFG_DEBUG", "0")  # --debug sets it to 1; undone after the test, so later subprocesses don't inherit it
     monkeypatch.setattr(sys, "argv", ["robocfg", "--debug", "inspect", "pnda"])
     from robocfg.errors import NotFound
 
