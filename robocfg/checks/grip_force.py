@@ -22,14 +22,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robocfg.assets.fingers import FingerGeometryMissing, closing_axis, width_curve
 from robocfg.assets.object_shape import object_shape
-from robocfg.assets.paths import Resolver, UnresolvedPath
+from robocfg.assets.paths import UnresolvedPath
 from robocfg.checks.robot import CheckedRobot
 from robocfg.config.load import YamlDocument
 from robocfg.config.robot import ArmConfig, ParallelGripperConfig
 from robocfg.config.task import PickPlaceTask
-from robocfg.config.types import AXIS_INDEX
 from robocfg.errors import Problem
 from robocfg.geometry import quat_to_matrix
 
@@ -79,14 +77,10 @@ def pad_force(robot: CheckedRobot, arm: ArmConfig) -> PadForce | None:
     """Each pad's normal force at the force limit over the gripper's travel, by virtual work on
     the URDF's pad-gap curve; None without finger geometry or travel, or for a suction cup."""
     g = arm.gripper
-    if not isinstance(g, ParallelGripperConfig):
+    curve = robot.pad_gap_curve(arm)
+    if curve is None or not isinstance(g, ParallelGripperConfig):
         return None
-    try:
-        s, gaps = width_curve(robot.urdf, Resolver(robot.path.parent, robot.config.package_dirs), arm.ee_link,
-                              AXIS_INDEX[arm.ee_axis], list(g.finger_links), robot.gripper_joints(arm),
-                              g.open, g.closed, closing_axis(arm.R_ee_graspnet))
-    except (FingerGeometryMissing, KeyError, ValueError):
-        return None
+    s, gaps = curve
     if np.ptp(gaps) < 1e-4:
         return None
     slope = np.abs(np.gradient(gaps, s))  # m of gap per unit of opening fraction

@@ -10,12 +10,15 @@ import hashlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import Urdf, UrdfParseError, missing_link_mass
 from robocfg.assets.urdf_xml import parse_urdf
 from robocfg.checks.arm import Collector, check_arm, known
 from robocfg.config.load import YamlDocument, load_yaml
 from robocfg.config.robot import ArmConfig, ParallelGripperConfig, RobotConfig
+from robocfg.config.types import AXIS_INDEX
 from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError, Problem
 
@@ -48,6 +51,23 @@ class CheckedRobot:
         if g.joints is not None:
             return list(g.joints)
         return [self.urdf.dof_joints[i] for i in g.gripper_indices or []]
+
+    def pad_gap_curve(self, arm: ArmConfig) -> tuple[np.ndarray, np.ndarray] | None:
+        """(opening fraction s ∈ [0, 1], 0 = closed, 1 = open; pad gap in m) over the travel of
+        ``arm``'s parallel gripper, by FK of the URDF's finger geometry
+        (:func:`robocfg.assets.fingers.width_curve`); None for a suction cup or where the finger
+        geometry is missing."""
+        from robocfg.assets.fingers import FingerGeometryMissing, closing_axis, width_curve
+
+        g = arm.gripper
+        if not isinstance(g, ParallelGripperConfig):
+            return None
+        try:
+            return width_curve(self.urdf, Resolver(self.path.parent, self.config.package_dirs), arm.ee_link,
+                               AXIS_INDEX[arm.ee_axis], list(g.finger_links), self.gripper_joints(arm),
+                               g.open, g.closed, closing_axis(arm.R_ee_graspnet))
+        except (FingerGeometryMissing, KeyError, ValueError):
+            return None
 
     def mimic_followers(self, leaders: list[str]) -> list[str]:
         return [j.name for j in self.urdf.joints.values() if j.mimic is not None and j.mimic.joint in leaders]

@@ -153,19 +153,10 @@ class ParallelGripper(Gripper):
 def _width_curve(checked: CheckedRobot, arm_cfg: ArmConfig) -> tuple[np.ndarray, np.ndarray] | None:
     """Pad gap vs opening fraction from the URDF, or None when it cannot be computed or is not
     monotonic (then ``set_width`` stays linear)."""
-    from robocfg.assets.fingers import FingerGeometryMissing, closing_axis, width_curve
-    from robocfg.assets.paths import Resolver
-    from robocfg.config.types import AXIS_INDEX
-
-    g = arm_cfg.gripper
-    if not isinstance(g, ParallelGripperConfig):
+    curve = checked.pad_gap_curve(arm_cfg)
+    if curve is None:
         return None
-    try:
-        s, gaps = width_curve(checked.urdf, Resolver(checked.path.parent, checked.config.package_dirs), arm_cfg.ee_link,
-                              AXIS_INDEX[arm_cfg.ee_axis], list(g.finger_links), checked.gripper_joints(arm_cfg),
-                              g.open, g.closed, closing_axis(arm_cfg.R_ee_graspnet))
-    except (FingerGeometryMissing, KeyError, ValueError):
-        return None
+    s, gaps = curve
     d = np.diff(gaps)
     if not (np.all(d >= -1e-6) or np.all(d <= 1e-6)) or np.ptp(gaps) < 1e-4:
         return None
