@@ -1,15 +1,21 @@
-"""The dataset sink a ``run`` command records into (its ``--dataset*`` options are the kind's)."""
+"""The dataset sink a ``run`` command records into: every kind whose ``Options`` subclass
+:class:`robocfg.engine.dataset.DatasetOptions` (pick-place, grasp, trajectory) gets the
+``--dataset*`` options, and :data:`DATASET_HOOK` turns them into a sink before the run and closes
+it (printing its summary) after."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import typer
 
+from robocfg.cli.run_command import CliHook
+
 
 def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: int, arm: str | None,
-                 robot: str | None, language: str):
+                 robot: str | None, language: str, renderer: str = "auto"):
     """The sink recording a run into ``path`` (None: no dataset). Bad choices are user errors."""
     if path is None:
         return None
@@ -31,4 +37,33 @@ def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: i
     fmt_l: Literal["lerobot", "hdf5"] = "lerobot" if fmt == "lerobot" else "hdf5"
     keep_l: Literal["success", "all"] = "all" if keep == "all" else "success"
     info = {"task_path": str(Path(task.path).resolve()), "robot_override": robot, "seed": seed, "arm": arm, "keep": keep}
-    return DatasetSink(path, fmt_l, task, fps=fps, keep=keep_l, language=language, extra_info=info)
+    from robocfg.sim.camera_rig import Renderer
+
+    renderers: dict[str, Renderer] = {"auto": "auto", "tiny": "tiny", "exact": "exact", "egl": "egl"}
+    if renderer not in renderers:
+        raise typer.BadParameter(f"{renderer!r}: choose one of {', '.join(renderers)}", param_hint="--dataset-renderer")
+    return DatasetSink(path, fmt_l, task, fps=fps, keep=keep_l, language=language, extra_info=info,
+                       renderer=renderers[renderer])
+
+
+def _prepare(task: Any, options: Any, robot: str | None) -> Any:
+    from robocfg.engine.dataset import DatasetOptions
+
+    x = options.extras
+    if not isinstance(x, DatasetOptions) or x.dataset is None:
+        return options
+    seed = options.resolved_seed(task.config.sim.seed)
+    sink = dataset_sink(x.dataset, x.dataset_format, x.dataset_fps, x.keep, task, seed, options.arm, robot, "",
+                        x.dataset_renderer)
+    return dataclasses.replace(options, sink=sink)
+
+
+def _finish(options: Any, report: Any) -> list[str]:
+    if options.sink is None:
+        return []
+    written = options.sink.close()
+    return [f"dataset ({written.format}): {written.episodes_kept}/{written.episodes_run} episodes kept, "
+            f"{written.frames} frames → {written.path}"]
+
+
+DATASET_HOOK = CliHook(_prepare, _finish)  # the kind gives each episode's instruction (language)

@@ -17,7 +17,6 @@ class _KindsGroup(TyperGroup):
 
     def _commands(self) -> Any:
         if not self._kinds_loaded:
-            from robocfg.cli import run_pick_place  # noqa: F401  (registers the dataset hook)
             from robocfg.cli.help_style import polish
             from robocfg.cli.run_command import make_command
             from robocfg.engine.registry import command_name, registered

@@ -5,7 +5,8 @@ The options every kind gets: ``TASK``, ``--robot/-r``, ``--arm``, ``--seed``, ``
 ``--json``, ``--record``, ``--record-episode``, ``--camera``, ``--size``, ``--fps``, ``--gui``, ``-q``,
 ``--min-success``, ``--set``. A kind's own
 options are the fields of its ``Options`` dataclass (``robocfg.engine.option``). Front-end
-additions that need the CLI's own imports (the dataset sink of pick-place) are :class:`CliHook` s.
+additions that need the CLI's own imports are :class:`CliHook` s: the dataset sink of every kind
+whose ``Options`` subclass ``DatasetOptions`` (``robocfg.cli.dataset_opts``), and ``HOOKS[kind]``.
 """
 
 from __future__ import annotations
@@ -155,6 +156,7 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     from robocfg.cli.executor_opts import resolve_workers
     from robocfg.cli.run_print import print_report
     from robocfg.cli.set_option import overrides
+    from robocfg.engine.dataset import DatasetOptions
     from robocfg.engine.options import RunOptions
     from robocfg.engine.registry import command_name
     from robocfg.engine.runner import RunOutput
@@ -176,6 +178,10 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     runner = runner_type(checked, options)
     runner.check()  # exit 2 before anything is simulated
     hook = HOOKS.get(kind)
+    if hook is None and runner_type.Options is not None and issubclass(runner_type.Options, DatasetOptions):
+        from robocfg.cli.dataset_opts import DATASET_HOOK
+
+        hook = DATASET_HOOK
     if hook is not None:
         runner.options = hook.prepare(checked, runner.options, robot)
     failed: PhaseFailed | None = None

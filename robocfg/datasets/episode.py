@@ -22,8 +22,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-PICK_PLACE_PHASES = ("setup", "pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
-
 
 @dataclass(frozen=True)
 class CameraLayout:
@@ -45,7 +43,7 @@ class DatasetLayout:
     state_names: tuple[str, ...]
     env_state_names: tuple[str, ...]
     action_names: tuple[str, ...]
-    phases: tuple[str, ...] = PICK_PLACE_PHASES
+    phases: tuple[str, ...] = ()  # the kind's phase names (EpisodeSession.phases)
     cameras: tuple[CameraLayout, ...] = ()
 
 

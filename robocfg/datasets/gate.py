@@ -26,11 +26,14 @@ class CommandGate:
         self.world, self.arm, self.gripper = world, arm, arm.gripper
         self.steps_per_frame = steps_per_frame
         drives = arm.robot.drives
-        self.q_wanted = np.array([drives[j].target if j in drives else q
+        self.q_wanted: np.ndarray | list[float] = np.array([drives[j].target if j in drives else q
                                   for j, q in zip(arm.joints, arm.joint_positions(), strict=True)])
         self.g_wanted = OPEN
         self._g_applied = OPEN  # a restored world starts with the gripper reset open
         self._prev = self._cur = self._round(np.append(self.q_wanted, OPEN))
+        self._steps = np.arange(1, steps_per_frame + 1)[:, None] / steps_per_frame  # ramp fractions (n, 1)
+        self._interval = steps_per_frame * world.dt  # s between frames
+        self._a = np.empty(len(arm.joints) + 1, np.float32)  # action k, filled in place
         self._real_command = arm.command
         self._real_open = getattr(self.gripper, "open", None)
         self._real_close = getattr(self.gripper, "close", None)
@@ -49,7 +52,8 @@ class CommandGate:
             self.gripper.__dict__.pop("close", None)
 
     def _want_arm(self, q, velocities=None) -> None:
-        self.q_wanted = np.asarray(q, dtype=float).copy()
+        # a list (a trajectory converted once) is kept as it is; an array is copied (callers reuse theirs)
+        self.q_wanted = q if type(q) is list else np.array(q, dtype=float)
 
     def _want_gripper(self, g: float) -> None:
         self.g_wanted = g
@@ -58,13 +62,20 @@ class CommandGate:
     def latch(self, action: np.ndarray | None = None, first: bool = False) -> np.ndarray:
         """Take action k (the runner's latest wish, or ``action`` on replay); returns it (float64
         values exactly representable in float32)."""
-        a = self._round(np.append(self.q_wanted, self.g_wanted) if action is None else np.asarray(action))
+        if action is None:
+            buf = self._a
+            buf[:-1] = self.q_wanted
+            buf[-1] = self.g_wanted
+            a = buf.astype(np.float64)
+        else:
+            a = self._round(action)
         self._prev, self._cur = (a if first else self._cur), a
-        n, delta = self.steps_per_frame, a[:-1] - self._prev[:-1]
+        prev = self._prev[:-1]
+        delta = a[:-1] - prev
         # the interval's targets, computed once: the drives' per-step path then only sends them
-        self._ramp = (self._prev[:-1] + np.outer(np.arange(1, n + 1) / n, delta)).tolist()
-        self._slope = (delta / (n * self.world.dt)).tolist()
-        self._moving = bool(np.any(delta))
+        self._ramp = (prev + self._steps * delta).tolist()
+        self._slope = (delta / self._interval).tolist()
+        self._moving = bool(delta.any())
         g = float(a[-1])
         real = self._real_open if g > 0 else self._real_close
         if g != self._g_applied and real is not None:

@@ -1,4 +1,4 @@
-"""The language instruction stored with every pick-place episode, from the task's object."""
+"""The language instruction stored with every recorded episode, from the episode's object."""
 
 from __future__ import annotations
 
@@ -17,6 +17,19 @@ def colour_name(rgba) -> str:
 
 def pick_place_instruction(params) -> str:
     """E.g. "pick the red cube and place it on the target" (``params``: PickPlaceParams)."""
-    obj = params.object
-    colour = f"{colour_name(obj.color)} " if getattr(obj, "color", None) else ""
-    return f"pick the {colour}{obj.name.replace('_', ' ')} and place it on the target"
+    return f"pick the {_named(params.object)} and place it on the target"
+
+
+def _named(body) -> str:
+    colour = f"{colour_name(body.color)} " if getattr(body, "color", None) else ""
+    return f"{colour}{body.name.replace('_', ' ')}"
+
+
+def grasp_instruction(body) -> str:
+    """E.g. "grasp the red cube and lift it" (``body``: the episode's object, a scene Body)."""
+    return f"grasp the {_named(body)} and lift it"
+
+
+def trajectory_instruction(waypoints: int) -> str:
+    """E.g. "move the arm through 4 waypoints"."""
+    return f"move the arm through {waypoints} waypoints"

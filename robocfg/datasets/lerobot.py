@@ -43,6 +43,13 @@ def image_key(camera: str) -> str:
     return f"observation.images.{camera}"
 
 
+def vector_dims(layout: DatasetLayout) -> dict[str, int]:
+    """Feature key → width of the float vectors stored (no environment state when the episodes
+    have no object, e.g. a trajectory run)."""
+    dims = {STATE: len(layout.state_names), ENV: len(layout.env_state_names), ACTION: len(layout.action_names)}
+    return {k: d for k, d in dims.items() if d or k != ENV}
+
+
 class LeRobotWriter:
     """Add episodes one by one (videos are encoded as they come), then ``close()``."""
 
@@ -107,8 +114,7 @@ class LeRobotWriter:
         fps = self.layout.fps
         cols = {k: np.concatenate(v) if v else np.zeros(0) for k, v in self.columns.items()}
         n = self.frames
-        dims = {STATE: len(self.layout.state_names), ENV: len(self.layout.env_state_names),
-                ACTION: len(self.layout.action_names)}
+        dims = vector_dims(self.layout)
         arrays = {key: _fixed_list(cols[key].reshape(n, d), d) for key, d in dims.items()}
         arrays |= {
             "timestamp": pa.array((cols["frame_index"] / fps).astype(np.float32)),
@@ -134,11 +140,9 @@ class LeRobotWriter:
     def _info(self) -> dict:
         lay = self.layout
         scalar: dict = {"dtype": "int64", "shape": [1], "names": None}
-        features: dict[str, dict] = {
-            STATE: {"dtype": "float32", "shape": [len(lay.state_names)], "names": list(lay.state_names)},
-            ENV: {"dtype": "float32", "shape": [len(lay.env_state_names)], "names": list(lay.env_state_names)},
-            ACTION: {"dtype": "float32", "shape": [len(lay.action_names)], "names": list(lay.action_names)},
-        }
+        names = {STATE: lay.state_names, ENV: lay.env_state_names, ACTION: lay.action_names}
+        features: dict[str, dict] = {key: {"dtype": "float32", "shape": [d], "names": list(names[key])}
+                                     for key, d in vector_dims(lay).items()}
         for c in lay.cameras:
             features[image_key(c.name)] = {
                 "dtype": "video", "shape": [c.height, c.width, 3], "names": ["height", "width", "channels"],

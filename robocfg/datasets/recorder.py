@@ -1,8 +1,10 @@
 """Sample observations and actions of one episode at the dataset rate, through the command gate.
 
-``EpisodeRecorder.start()`` right after the episode's world is set up (frame 0), ``on_step()``
-after every physics step, ``finish(...)`` at the end. The runner's only coupling is those three
-calls (see :mod:`robocfg.datasets.pick_place`).
+``EpisodeRecorder.start()`` right after the episode's world is set up (frame 0) hooks ``on_step``
+into the world's steps (``World.step_hooks``: whatever code steps the world is sampled);
+``finish(...)`` at the end unhooks it. The engine drives both (``EpisodeSession.record_from``,
+:mod:`robocfg.engine.dataset`); runners never call them. A frame only reads the simulator
+(plain tuples, appended); arrays are built once, at the end of the episode.
 """
 
 from __future__ import annotations
@@ -27,24 +29,26 @@ def steps_per_frame(dt: float, fps: float) -> int:
     return n
 
 
-def layout_names(arm) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
-    """(state, env_state, action) entry names for ``arm`` (see :mod:`robocfg.datasets.episode`)."""
+def layout_names(arm, has_object: bool = True) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+    """(state, env_state, action) entry names for ``arm`` (see :mod:`robocfg.datasets.episode`);
+    no env_state entries when the episodes have no object."""
     grip = tuple(arm.robot.checked.gripper_joints(arm.config)) if arm.gripper is not None else ()
     joints = tuple(arm.joints) + grip
     state = (*(f"{j}.pos" for j in joints), *(f"{j}.vel" for j in joints),
              *(f"tcp.{k}" for k in ("x", "y", "z", "qx", "qy", "qz", "qw")), "gripper.opening")
-    env = tuple(f"object.{k}" for k in ("x", "y", "z", "qx", "qy", "qz", "qw"))
+    env = tuple(f"object.{k}" for k in ("x", "y", "z", "qx", "qy", "qz", "qw")) if has_object else ()
     action = (*(f"{j}.target" for j in arm.joints), "gripper.command")
     return state, env, action
 
 
 class EpisodeRecorder:
-    """Frames of one episode of ``world`` (``arm`` acting, ``obj`` the object's body id)."""
+    """Frames of one episode of ``world`` (``arm`` acting, ``obj`` the object's body id, None:
+    no object); ``language``: the episode's instruction ("": the sink's)."""
 
-    def __init__(self, world, arm, obj: int, layout: DatasetLayout, rig, phase_of: Callable[[], str],
-                 replay_actions: np.ndarray | None = None):
+    def __init__(self, world, arm, obj: int | None, layout: DatasetLayout, rig, phase_of: Callable[[], str],
+                 replay_actions: np.ndarray | None = None, language: str = ""):
         self.world, self.arm, self.obj, self.layout, self.rig = world, arm, obj, layout, rig
-        self.phase_of = phase_of
+        self.phase_of, self.language = phase_of, language
         self.n = steps_per_frame(world.dt, layout.fps)
         self.gate = CommandGate(world, arm, self.n)
         self.replay_actions = replay_actions
@@ -52,19 +56,25 @@ class EpisodeRecorder:
         self._joint_names = list(arm.joints) + grip
         self._base_inv = np.linalg.inv(world.robot.base_pose())
         self._phase_index = {p: i for i, p in enumerate(layout.phases)}
-        self.joints: list[np.ndarray] = []  # positions then velocities
+        self._hooked = False
+        # per frame, as the simulator gives them (converted to arrays in ``finish``)
+        self.q: list[list[float]] = []  # joint positions (arm then gripper joints)
+        self.qd: list[list[float]] = []  # their velocities
         self.opening: list[float] = []
-        self.T_ee: list[np.ndarray] = []  # ee_link world position + quaternion x y z w per frame
-        self.obj_pose: list[np.ndarray] = []  # world position + quaternion x y z w per frame
+        self.ee: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # ee_link world (position, quat x y z w)
+        self.obj_pose: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # object world (position, quat)
         self.actions: list[np.ndarray] = []
         self.phases: list[int] = []
         self.images: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras}
         self.depth: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras if c.depth}
 
     def start(self) -> None:
+        """Frame 0 now; from here every physics step of the world is sampled."""
         self.gate.install()
         self._frame(first=True)
         self.gate.drive(1)
+        self.world.step_hooks.append(self.on_step)
+        self._hooked = True
 
     def on_step(self) -> None:
         j = self.world.steps % self.n
@@ -73,6 +83,10 @@ class EpisodeRecorder:
         self.gate.drive(j + 1)
 
     def stop(self) -> None:
+        """Unhook from the world's steps and give the commands back (idempotent)."""
+        if self._hooked:
+            self.world.step_hooks.remove(self.on_step)
+            self._hooked = False
         self.gate.remove()
 
     def _frame(self, first: bool = False) -> None:
@@ -83,12 +97,14 @@ class EpisodeRecorder:
         else:
             a = self.gate.latch(first=first)
         self.actions.append(a)
-        r, arm, names = self.arm.robot, self.arm, self._joint_names
-        self.joints.append(np.concatenate([r.joint_positions(names), r.joint_velocities(names)]))
+        r, arm = self.arm.robot, self.arm
+        q, qd = r.joint_states(self._joint_names)
+        self.q.append(q)
+        self.qd.append(qd)
         self.opening.append(arm.gripper.fraction() if arm.gripper is not None else 0.0)
-        pos, quat = r.link_position_quat(arm.config.ee_link)
-        self.T_ee.append(np.concatenate([pos, quat]))
-        self.obj_pose.append(np.concatenate(self.world.body_pose(self.obj)))
+        self.ee.append(r.link_position_quat(arm.config.ee_link))
+        if self.obj is not None:
+            self.obj_pose.append(self.world.body_pose_tuple(self.obj))
         self.phases.append(self._phase_index.get(self.phase_of(), 0))
         if self.rig is not None and self.layout.cameras:
             for name, img in self.rig.render_all().items():
@@ -96,33 +112,51 @@ class EpisodeRecorder:
                 if img.depth is not None:
                     self.depth[name].append(img.depth)
 
+    @staticmethod
+    def _poses(frames: list) -> np.ndarray:
+        """(T, 7) position + quaternion x y z w from (position, quaternion) tuples."""
+        return np.array([(*pos, *quat) for pos, quat in frames], dtype=float).reshape(-1, 7)
+
     def _in_base(self) -> tuple[np.ndarray, np.ndarray]:
-        """(T, 7) TCP and (T, 7) object poses in the robot base frame (position m, quaternion
+        """(T, 7) TCP and (T, 7 or 0) object poses in the robot base frame (position m, quaternion
         x y z w), converted for all frames at once."""
         Tb = self._base_inv
         T_off = np.eye(4)
         T_off[AXIS_INDEX[self.arm.config.ee_axis], 3] = self.arm.config.tcp_offset
-        ee = np.asarray(self.T_ee).reshape(-1, 7)
+        ee = self._poses(self.ee)
         T_ee = np.tile(np.eye(4), (len(ee), 1, 1))
         T_ee[:, :3, :3], T_ee[:, :3, 3] = Rotation.from_quat(ee[:, 3:]).as_matrix(), ee[:, :3]
         T_tcp = Tb @ T_ee @ T_off
         tcp = np.concatenate([T_tcp[:, :3, 3], Rotation.from_matrix(T_tcp[:, :3, :3]).as_quat()], axis=1)
-        obj = np.asarray(self.obj_pose).reshape(-1, 7)
+        if self.obj is None:
+            return tcp, np.zeros((len(tcp), 0))
+        obj = self._poses(self.obj_pose)
         pos = obj[:, :3] @ Tb[:3, :3].T + Tb[:3, 3]
         quat = (Rotation.from_matrix(Tb[:3, :3]) * Rotation.from_quat(obj[:, 3:])).as_quat()
         return tcp, np.concatenate([pos, quat], axis=1)
 
+    def final_pose(self) -> list[float]:
+        """The object's world pose now (position m, quaternion x y z w); with no object, the TCP's."""
+        if self.obj is not None:
+            pos, quat = self.world.body_pose_tuple(self.obj)
+            return [*map(float, pos), *map(float, quat)]
+        from robocfg.geometry.pose import matrix_to_pose
+
+        pos, quat = matrix_to_pose(self.arm.tcp_pose())
+        return [*map(float, pos), *map(float, quat)]
+
     def finish(self, index: int, seed: int, language: str, success: bool, failed_phase: str | None,
                reason: str) -> EpisodeRecord:
-        """The episode's record (the gate is removed)."""
+        """The episode's record (the recorder is stopped)."""
         self.stop()
-        pos, quat = self.world.body_pose(self.obj)
         tcp, env = self._in_base()
-        state = np.concatenate([np.asarray(self.joints).reshape(len(tcp), -1), tcp,
-                                np.asarray(self.opening)[:, None]], axis=1)
+        n = len(tcp)
+        joints = np.concatenate([np.asarray(self.q, float).reshape(n, -1), np.asarray(self.qd, float).reshape(n, -1)],
+                                axis=1)
+        state = np.concatenate([joints, tcp, np.asarray(self.opening, float)[:, None]], axis=1)
         return EpisodeRecord(
-            index=index, seed=seed, language=language, success=success, failed_phase=failed_phase,
-            reason=reason, physics_steps=self.world.steps, object_final=[*map(float, pos), *map(float, quat)],
+            index=index, seed=seed, language=self.language or language, success=success, failed_phase=failed_phase,
+            reason=reason, physics_steps=self.world.steps, object_final=self.final_pose(),
             state=state.astype(np.float32), env_state=env.astype(np.float32),
             action=np.asarray(self.actions, np.float32), phase=np.asarray(self.phases, np.int64),
             images={k: np.asarray(v, np.uint8) for k, v in self.images.items()},

@@ -103,16 +103,18 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
         STATE,
         VIDEO_PATH,
         image_key,
+        vector_dims,
     )
     from robocfg.datasets.video import split_segments
 
     root = Path(shard.path)
     rows = pq.read_table(root / EPISODES_PATH).to_pylist()
     data = pq.read_table(root / DATA_PATH.format(chunk_index=0, file_index=0))
-    cols = {k: np.asarray(data[k].combine_chunks().flatten().to_numpy(zero_copy_only=False))
-            for k in (STATE, ENV, ACTION)}
-    dims = {STATE: len(layout.state_names), ENV: len(layout.env_state_names), ACTION: len(layout.action_names)}
+    dims = vector_dims(layout)
+    cols = {k: np.asarray(data[k].combine_chunks().flatten().to_numpy(zero_copy_only=False)) for k in dims}
     vec = {k: cols[k].astype(np.float32).reshape(-1, d) for k, d in dims.items()}
+    if ENV not in vec:  # no object: zero-width environment state
+        vec[ENV] = np.zeros((data.num_rows, 0), np.float32)
     phase = data["phase_index"].to_numpy().astype(np.int64)
     lengths = [r["length"] for r in rows]
     segments = {c.name: split_segments(root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,

@@ -1,10 +1,11 @@
-"""The dataset sink a runner feeds: one :class:`EpisodeRecorder` per episode, kept episodes to a
-writer (LeRobot v3.0 or robomimic HDF5).
+"""The dataset sink the episode engine feeds: one :class:`EpisodeRecorder` per episode, kept
+episodes to a writer (LeRobot v3.0 or robomimic HDF5). It implements
+:class:`robocfg.engine.dataset.EpisodeSink`.
 
-A runner calls ``recorder = sink.begin(world, arm, obj, phase_of)`` once the episode's world is
-ready (before its first command), ``recorder.on_step()`` after every physics step, and
-``sink.end(recorder, index, seed, success, failed_phase, reason)`` when the episode is over;
-``sink.close()`` after the last one writes the metadata.
+The engine calls ``recorder = sink.begin(world, arm, obj, phase_of, phases, language)`` once the
+episode's world is ready (before its first command; the recorder then samples every physics
+step by itself), and ``sink.end(recorder, index, seed, success, failed_phase, reason)`` when the
+episode is over; ``sink.close()`` after the last one writes the metadata.
 """
 
 from __future__ import annotations
@@ -49,8 +50,9 @@ class DatasetSummary:
 class DatasetSink:
     """Records every episode of a run; ``keep="success"`` writes only successful ones.
 
-    ``language``: the task string stored with every episode; ``extra_info``: run facts stored in
-    the dataset metadata (task path, arm, seed) that replay needs; ``renderer``: camera renderer.
+    ``language``: the task string stored with every episode whose kind gives none; ``extra_info``:
+    run facts stored in the dataset metadata (task path, arm, seed) that replay needs;
+    ``renderer``: how camera images are drawn (``robocfg.sim.camera_rig``: auto, tiny, exact, egl).
     """
 
     root: Path
@@ -60,7 +62,7 @@ class DatasetSink:
     keep: Keep = "success"
     language: str = ""
     extra_info: dict = field(default_factory=dict)
-    renderer: Renderer = "tiny"
+    renderer: Renderer = "auto"
     writer: Any = field(default=None, init=False)
     layout: DatasetLayout | None = field(default=None, init=False)
     run: int = field(default=0, init=False)
@@ -68,20 +70,23 @@ class DatasetSink:
     frames: int = field(default=0, init=False)
     _rig: tuple | None = field(default=None, init=False)
 
-    def begin(self, world, arm, obj: int, phase_of: Callable[[], str]) -> EpisodeRecorder:
+    def begin(self, world, arm, obj: int | None, phase_of: Callable[[], str], phases: tuple[str, ...] = (),
+              language: str = "") -> EpisodeRecorder:
         from robocfg.sim.camera_rig import CameraRig
 
         cams = self.task.config.cameras
         if self.layout is None:
-            state, env, action = layout_names(arm)
+            state, env, action = layout_names(arm, has_object=obj is not None)
             self.layout = DatasetLayout(
                 fps=self.fps, robot=arm.robot.name, task_name=self.task.path.stem, state_names=state,
-                env_state_names=env, action_names=action,
+                env_state_names=env, action_names=action, phases=tuple(phases) or ("run",),
                 cameras=tuple(CameraLayout(c.name, c.height, c.width, c.depth) for c in cams))
             self.writer = make_writer(self.fmt, Path(self.root), self.layout, self.extra_info)
         if self._rig is None or self._rig[0] is not world:
+            if self._rig is not None:
+                self._rig[1].close()
             self._rig = (world, CameraRig(world, arm, cams, self.renderer))
-        rec = EpisodeRecorder(world, arm, obj, self.layout, self._rig[1], phase_of)
+        rec = EpisodeRecorder(world, arm, obj, self.layout, self._rig[1], phase_of, language=language)
         rec.start()
         return rec
 
@@ -95,6 +100,9 @@ class DatasetSink:
             self.frames += ep.length
 
     def close(self) -> DatasetSummary:
+        if self._rig is not None:
+            self._rig[1].close()
+            self._rig = None
         if self.writer is not None:
             self.writer.close()
         return DatasetSummary(str(self.root), self.fmt, self.kept, self.run, self.frames)

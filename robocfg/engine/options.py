@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
+    from robocfg.engine.dataset import EpisodeSink
     from robocfg.sim.world import World
 
 
@@ -83,7 +84,7 @@ class RunOptions:
     on_episode: Callable[[EpisodeOutcome], None] | None = None  # called with each finished episode record
     should_stop: Callable[[], bool] | None = None  # True once the run is asked to stop (SIGINT/SIGTERM)
     log: Callable[[str], None] | None = None  # phase log of episode 0 (one line per phase)
-    sink: Any = None  # a dataset sink (``robocfg.datasets.sink.DatasetSink``) recording every episode
+    sink: EpisodeSink | None = None  # a dataset sink (``robocfg.datasets.sink.DatasetSink``) recording every episode
 
     def resolved_seed(self, task_seed: int) -> int:
         return task_seed if self.seed is None else self.seed

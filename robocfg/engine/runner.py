@@ -13,6 +13,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections import Counter
 from collections.abc import Sequence
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar, Generic, Literal, Protocol, TypeVar
 
@@ -21,6 +22,7 @@ from robocfg.engine.options import EpisodeOutcome, RunOptions
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
     from robocfg.config.robot import RobotConfig
+    from robocfg.engine.dataset import ReplayScene
 
 
 @dataclass
@@ -167,3 +169,10 @@ class TaskRunner(ABC):
         from robocfg.engine.session import SingleRunSession
 
         return SingleRunSession(self)
+
+    def replay_scene(self, k: int) -> AbstractContextManager[ReplayScene]:
+        """A context giving episode ``k``'s world as its dataset recording began (the recorded
+        actions then drive it: ``robocfg dataset replay``). Kinds that record datasets give one."""
+        from robocfg.errors import RobocfgError
+
+        raise RobocfgError(f"'{self.kind}' runs cannot be replayed")

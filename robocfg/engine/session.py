@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
@@ -28,6 +29,8 @@ from robocfg.engine.runner import RunOutput, TaskRunner
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
     from robocfg.config.scene import Body
+    from robocfg.engine.dataset import EpisodeTap, ReplayScene
+    from robocfg.sim.robot import ArmHandle
     from robocfg.sim.world import World
 
 RecordT = TypeVar("RecordT", bound=EpisodeOutcome)
@@ -67,6 +70,8 @@ class Session(Protocol):
 class EpisodeSession(ABC, Generic[RecordT]):
     """One world and everything episodes share; ``run(k)`` gives episode k's record."""
 
+    phases: tuple[str, ...] = ()  # the kind's phase names, in order: a dataset's per-frame labels
+
     def __init__(self, task: CheckedTask, options: RunOptions, timing: BatchTiming | None = None):
         from robocfg.sim.world import World
 
@@ -74,6 +79,7 @@ class EpisodeSession(ABC, Generic[RecordT]):
         self.seed = options.resolved_seed(task.config.sim.seed)
         self.timing = timing if timing is not None else BatchTiming()
         self._spawned: list[str] = []
+        self._tap: EpisodeTap | None = None
         self.world: World = World(task, gui=options.gui)
         try:
             self.world.step(1)
@@ -95,6 +101,13 @@ class EpisodeSession(ABC, Generic[RecordT]):
     @abstractmethod
     def report(self, records: list[RecordT], interrupted: bool) -> Any:
         """The run's report from the records of the episodes that finished."""
+
+    def scene(self, k: int) -> ReplayScene:
+        """Set up episode ``k`` in the freshly restored world up to where its recording begins
+        (what ``episode`` does before calling :meth:`record_from`), for a replay."""
+        from robocfg.errors import RobocfgError
+
+        raise RobocfgError(f"'{self.task.config.task}' episodes cannot be replayed")
 
     def make_recorder(self, path: Any) -> FrameRecorder:
         """The picture recorder for ``--record PATH`` (default: the fitted scene camera)."""
@@ -120,17 +133,46 @@ class EpisodeSession(ABC, Generic[RecordT]):
         """Remove body ``name`` (spawned by this episode) before the next episode's restore."""
         self._spawned.append(name)
 
-    def run(self, k: int) -> RecordT:
-        """Run episode ``k`` (any order, any number of times: the same record for the same k)."""
+    def record_from(self, arm: ArmHandle, obj: int | None, phase_of: Callable[[], str],
+                    language: Callable[[], str] | None = None) -> None:
+        """With a dataset sink, record this episode from now on (call it once the episode's world
+        is ready, before the first command): ``arm`` acts, ``obj`` is the episode's object body (None:
+        none), ``phase_of()`` names the current phase (one of ``phases``), ``language()``: the
+        episode's instruction (None: the sink's). Without a sink: nothing (``language`` is not
+        called). The engine ends the recording."""
+        sink = self.options.sink
+        if sink is not None and self._tap is None:
+            self._tap = sink.begin(self.world, arm, obj, phase_of, self.phases, language() if language else "")
+
+    def _reset(self) -> None:
+        """Remove what the last episode spawned and restore the snapshot."""
         w = self.world
         for name in self._spawned:
             if name in w.bodies:
                 w.remove_body(name)
         self._spawned.clear()
         w.restore(self._state)
+
+    def replay_scene(self, k: int) -> ReplayScene:
+        """Episode ``k``'s world, restored and set up as when its recording began (see ``scene``)."""
+        self._reset()
+        return self.scene(k)
+
+    def run(self, k: int) -> RecordT:
+        """Run episode ``k`` (any order, any number of times: the same record for the same k)."""
+        w = self.world
+        self._reset()
         t0, physics0 = time.perf_counter(), w.physics_seconds
         recorder = self._recorder(k)
-        record = self.episode(k, recorder)
+        self._tap = None
+        try:
+            record = self.episode(k, recorder)
+        finally:
+            tap, self._tap = self._tap, None
+            if tap is not None:
+                tap.stop()
+        if tap is not None and self.options.sink is not None:
+            self.options.sink.end(tap, k, self.seed + k, record.success, record.failed_phase, record.reason)
         if recorder is not None:
             ok = record.success  # the outcome banner of the last frame
             recorder.finish(ok, "" if ok else f"{record.failed_phase}: {record.reason}")
@@ -201,6 +243,11 @@ class EpisodicRunner(TaskRunner):
     @abstractmethod
     def open_session(self) -> EpisodeSession:
         """Build the world and what episodes share (the caller closes it)."""
+
+    @contextmanager
+    def replay_scene(self, k: int) -> Iterator[ReplayScene]:
+        with self.open_session() as session:
+            yield session.replay_scene(k)
 
     def run(self) -> RunOutput:
         t0 = time.perf_counter()

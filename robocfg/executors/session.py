@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 if TYPE_CHECKING:
     from robocfg.datasets.shards import Shard
     from robocfg.datasets.sink import DatasetSink, Format, Keep
+    from robocfg.sim.camera_rig import Renderer
 
 
 class EpisodeRecord(Protocol):
@@ -91,6 +92,7 @@ class DatasetTarget:
     keep: Keep
     language: str
     extra_info: dict = field(default_factory=dict)
+    renderer: Renderer = "auto"  # camera images (robocfg.sim.camera_rig)
 
     def shard_root(self, batch: int) -> Path:
         return Path(self.root) / ".shards" / f"batch-{batch:05d}"
@@ -99,7 +101,7 @@ class DatasetTarget:
         from robocfg.datasets.sink import DatasetSink
 
         return DatasetSink(root, self.fmt, task, fps=self.fps, keep=self.keep, language=self.language,
-                           extra_info=dict(self.extra_info))
+                           extra_info=dict(self.extra_info), renderer=self.renderer)
 
 
 @dataclass(frozen=True)

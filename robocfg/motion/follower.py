@@ -60,21 +60,26 @@ class Tracking:
 
 
 def follow(world, names: list[str], traj: Trajectory, settle_time: float = 0.25, mode: str = "matched",
-           on_step: Callable[[], None] | None = None) -> Tracking:
+           on_step: Callable[[], None] | None = None,
+           command: Callable[[np.ndarray, np.ndarray], None] | None = None) -> Tracking:
     """Play ``traj`` on the world's first robot, joints ``names``; the robot should be at the
-    trajectory's start. ``on_step`` runs after every physics step (e.g. a recorder)."""
+    trajectory's start. ``on_step`` runs after every physics step (e.g. a recorder); ``command(q,
+    q̇)`` sends the targets (default: the robot's position drives of ``names``; an arm's
+    ``command`` lets a dataset recording intercept them)."""
     if mode not in ("matched", "next"):
         raise ValueError(f"unknown follower mode {mode!r}")
     robot, dt = world.robot, float(world.dt)
+    send = command if command is not None else (lambda q, qd: robot.command_positions(names, q, qd))
+
     n_steps = int(np.ceil(traj.duration / dt - 1e-9))
     times = np.arange(n_steps + 1) * dt
     q_ref, qd_ref, _ = traj.evaluate(times)  # clipped to the end time
     ts, qs, errs = [0.0], [robot.joint_positions(names)], [robot.joint_positions(names) - q_ref[0]]
     for k in range(n_steps):
         if mode == "matched":
-            robot.command_positions(names, q_ref[k], (q_ref[k + 1] - q_ref[k]) / dt)
+            send(q_ref[k], (q_ref[k + 1] - q_ref[k]) / dt)
         else:
-            robot.command_positions(names, q_ref[k + 1], qd_ref[k + 1])
+            send(q_ref[k + 1], qd_ref[k + 1])
         world.step()
         if on_step is not None:
             on_step()
@@ -84,7 +89,7 @@ def follow(world, names: list[str], traj: Trajectory, settle_time: float = 0.25,
         errs.append(q - q_ref[k + 1])
     q_end = q_ref[-1]
     final = np.abs(qs[-1] - q_end)
-    robot.command_positions(names, q_end, np.zeros(len(names)))
+    send(q_end, np.zeros(len(names)))
     for _ in range(round(settle_time / dt)):
         world.step()
         if on_step is not None:

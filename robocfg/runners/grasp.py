@@ -14,6 +14,8 @@ from typing import Any
 
 from robocfg.config.commands import GraspParams, Limits
 from robocfg.config.robot import ParallelGripperConfig
+from robocfg.datasets.language import grasp_instruction
+from robocfg.engine.dataset import DatasetOptions, ReplayScene
 from robocfg.engine.options import FrameRecorder, RunOptions, option
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
@@ -37,8 +39,8 @@ def episode_setups(params: GraspParams, seed: int, episodes: int) -> list[Episod
 
 
 @dataclass(frozen=True)
-class GraspOptions:
-    """``run grasp``'s own options."""
+class GraspOptions(DatasetOptions):
+    """``run grasp``'s own options (and the ``--dataset*`` ones)."""
 
     save_cloud: Path | None = field(default=None, metadata=option(
         "--save-cloud", output=(".npz", ".ply"), help="Write the first object cloud (.npz or .ply)."))
@@ -46,6 +48,9 @@ class GraspOptions:
 
 class GraspSession(EpisodeSession[GraspEpisode]):
     """The grasp world, the measured gripper boxes, IK model and limits, shared by every episode."""
+
+    # "settle": the spawned object comes to rest and is perceived; "recover": back home after a failed attempt
+    phases = ("settle", "pre_grasp", "approach", "grasp", "lift", "shake", "recover")
 
     def __init__(self, task, options: RunOptions, on_cloud: Callable[[Any], None] | None = None):
         self.on_cloud = on_cloud  # called with the first processed object cloud
@@ -78,10 +83,30 @@ class GraspSession(EpisodeSession[GraspEpisode]):
                         shake_limits=limits_from_robot(robot, handle.joints, Limits()),
                         boxes=self.boxes, timing=self.timing, save_cloud=self.on_cloud)
 
-    def episode(self, k: int, recorder: FrameRecorder | None) -> GraspEpisode:
+    def _episode(self, k: int, recorder: FrameRecorder | None) -> _Episode:
+        """Episode ``k`` in the restored world (it spawns the object)."""
         setup = episode_setup(self.params, self.seed, k)
         self.remove_after_episode(setup.body.name)
-        return _Episode(self.ctx, setup, recorder, self.log_for(k)).run()
+        return _Episode(self.ctx, setup, recorder, self.log_for(k))
+
+    def episode(self, k: int, recorder: FrameRecorder | None) -> GraspEpisode:
+        ep = self._episode(k, recorder)
+        self.record_from(self.ctx.arm, ep.obj, lambda: "settle" if ep.mover.phase == "move" else ep.mover.phase,
+                         lambda: grasp_instruction(ep.setup.body))
+        return ep.run()
+
+    def scene(self, k: int) -> ReplayScene:
+        ep = self._episode(k, None)
+        z0, lift = float(self.world.body_pose(ep.obj)[0][2]), self.params.lift_height
+
+        def judge() -> tuple[bool, str]:
+            """Held at the end and raised by half the lift height or more (from where it was spawned)."""
+            rise = float(self.world.body_pose(ep.obj)[0][2]) - z0
+            if ep.gripper.is_grasping(ep.obj) and rise >= 0.5 * lift:
+                return True, "lifted"
+            return False, f"object not held (rose {rise * 100:.1f} cm of {lift * 100:.0f})"
+
+        return ReplayScene(self.world, self.ctx.arm, ep.obj, judge)
 
     def make_recorder(self, path: Any) -> FrameRecorder:
         from robocfg.grasp.draw import GraspRecorder

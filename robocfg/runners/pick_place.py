@@ -9,15 +9,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from robocfg.config.commands import Limits, PickPlaceParams
 from robocfg.config.robot import ParallelGripperConfig
-from robocfg.engine.options import FrameRecorder, RunOptions, option
+from robocfg.datasets.language import pick_place_instruction
+from robocfg.engine.dataset import DatasetOptions, ReplayScene
+from robocfg.engine.options import FrameRecorder, RunOptions
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
@@ -60,22 +61,14 @@ def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[Ep
 
 
 @dataclass(frozen=True)
-class PickPlaceOptions:
+class PickPlaceOptions(DatasetOptions):
     """``run pick-place``'s own options: recording a dataset (the CLI builds the sink from them)."""
-
-    dataset: Path | None = field(default=None, metadata=option(
-        "--dataset", help="Record the episodes into this new directory (see --dataset-format)."))
-    dataset_format: str = field(default="lerobot", metadata=option(
-        "--dataset-format", choices=("lerobot", "hdf5"),
-        help="lerobot (LeRobot v3.0: parquet + MP4) or hdf5 (robomimic layout)."))
-    dataset_fps: int = field(default=20, metadata=option(
-        "--dataset-fps", minimum=1, help="Frames per second of simulated time (must divide the physics rate)."))
-    keep: str = field(default="success", metadata=option(
-        "--keep", choices=("success", "all"), help="success: write successful episodes only; all: failures too, labelled."))
 
 
 class PickPlaceSession(EpisodeSession[EpisodeResult]):
     """The pick-place world, kinematic model and limits, shared by every episode."""
+
+    phases = ("setup", "pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
 
     def prepare(self) -> None:
         from robocfg.assets.object_shape import object_shape
@@ -108,25 +101,37 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
                             planned_drive(robot, self.world, model, self.params), shape=shape, boxes=boxes,
                             pad_force=force)
 
-    def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
+    def _machine(self, k: int, recorder: FrameRecorder | None) -> _StateMachine:
+        """Episode ``k``'s state machine in the restored world (it spawns the object)."""
         setup = episode_setup(self.params, self.seed, k)
+        self.remove_after_episode(setup.body.name)
+        return _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k))
+
+    def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
         if self.blocked is not None:
+            setup = episode_setup(self.params, self.seed, k)
             return not_simulated(setup, self.blocked.phase, f"{self.blocked.reason}; checked before simulating")
-        self.remove_after_episode(setup.body.name)  # the state machine spawns it
-        sm = _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k))
-        sink = self.options.sink
-        if sink is not None:
-            sm.sink = sink.begin(self.world, self.handle, sm.obj, lambda: sm.mover.phase)
+        sm = self._machine(k, recorder)
+        self.record_from(self.handle, sm.obj, lambda: sm.mover.phase, lambda: pick_place_instruction(self.params))
         try:
             sm.run()
             failed, reason = None, "placed"
         except MoveFailed as exc:
             failed, reason = exc.phase, exc.reason
             sm.close_phase(False, reason)
-        res = sm.result(failed, reason)
-        if sm.sink is not None:
-            sink.end(sm.sink, setup.index, setup.seed, res.success, res.failed_phase, res.reason)
-        return res
+        return sm.result(failed, reason)
+
+    def scene(self, k: int) -> ReplayScene:
+        sm = self._machine(k, None)
+
+        def judge() -> tuple[bool, str]:
+            try:
+                sm._check_placed()
+                return True, "placed"
+            except MoveFailed as exc:
+                return False, f"{exc.phase}: {exc.reason}"
+
+        return ReplayScene(self.world, self.handle, sm.obj, judge)
 
     def report(self, records: list[EpisodeResult], interrupted: bool) -> PickPlaceReport:
         skipped = self.tools.reactive.skipped if self.tools.reactive is not None else []

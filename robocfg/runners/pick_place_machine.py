@@ -139,7 +139,6 @@ class _StateMachine:
         self.phases: list[PhaseRecord] = []
         self._phase: tuple[str, float] | None = None
         self.lift_rise: float | None = None
-        self.sink = None  # a dataset EpisodeRecorder: sees every physics step
 
     # ---- phases ------------------------------------------------------------------------------
     def run(self) -> None:
@@ -353,8 +352,6 @@ class _StateMachine:
 
     # ---- world helpers -----------------------------------------------------------------------
     def _on_step(self) -> None:
-        if self.sink is not None:
-            self.sink.on_step()
         if self.recorder is not None:
             self.recorder.maybe_capture()
 

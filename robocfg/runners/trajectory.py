@@ -11,6 +11,8 @@ trajectory (t, q, q̇, q̈) at ``sample_rate``.
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -18,10 +20,11 @@ import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import TrajectoryParams
+from robocfg.engine.dataset import DatasetOptions, EpisodeSink, ReplayScene
 from robocfg.engine.options import option
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import ReportView, RunOutput, TableView, TaskRunner
-from robocfg.errors import ConfigError, Problem, RunFailed, RunInterrupted
+from robocfg.errors import ConfigError, Problem, RobocfgError, RunFailed, RunInterrupted
 from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, SingleRunReport
 
 CHECK_RATE = 1000.0  # Hz: resampling rate of the limit check
@@ -110,8 +113,8 @@ class TrajectoryResult(SingleRunReport):
 
 
 @dataclass(frozen=True)
-class TrajectoryOptions:
-    """``run trajectory``'s own options."""
+class TrajectoryOptions(DatasetOptions):
+    """``run trajectory``'s own options (and the ``--dataset*`` ones: the run is episode 0)."""
 
     plot: Path | None = field(default=None, metadata=option(
         "--plot", output=(".png",), help="Write a PNG of q, q̇, q̈ per joint against time (limits dashed)."))
@@ -131,17 +134,35 @@ class TrajectoryRunner(TaskRunner):
     def check(self) -> None:
         super().check()
         x = self.options.extras
-        if isinstance(x, TrajectoryOptions) and x.no_sim and self.options.record is not None:
-            raise ConfigError([Problem("--record", None, None, "", "--record needs the simulation (drop --no-sim)")])
+        if isinstance(x, TrajectoryOptions) and x.no_sim:
+            for flag, given in (("--record", self.options.record is not None), ("--dataset", x.dataset is not None)):
+                if given:
+                    raise ConfigError([Problem(flag, None, None, "", f"{flag} needs the simulation (drop --no-sim)")])
 
     def run(self) -> RunOutput:
         o, x = self.options, self.options.extras
         no_sim = isinstance(x, TrajectoryOptions) and x.no_sim
         result = run_trajectory(self.task, gui=o.gui, record=o.record, follow=not no_sim, arm=o.arm,
-                                should_stop=o.should_stop, recording=o.recording)
+                                should_stop=o.should_stop, recording=o.recording, sink=o.sink,
+                                seed=o.resolved_seed(self.task.config.sim.seed))
         if isinstance(x, TrajectoryOptions) and x.plot is not None:
             plot_result(result, x.plot)
         return RunOutput(result)
+
+    @contextmanager
+    def replay_scene(self, k: int) -> Iterator[ReplayScene]:
+        """The world with the arm at the first waypoint, as the recording of the run (episode 0) began."""
+        from robocfg.motion.trajectory import check_limits
+        from robocfg.sim.world import World
+
+        if k != 0:
+            raise RobocfgError(f"a trajectory run is one episode (0); the dataset says {k}")
+        _params, arm_cfg, names, limits, _wps, plan = plan_task(self.task, self.options.arm)
+        passed = check_limits(plan.trajectory, limits, CHECK_RATE).total == 0
+        with World(self.task) as world:
+            _start(world, names, plan)
+            yield ReplayScene(world, world.robot.arm(arm_cfg.name), None,
+                              lambda: (passed, "ok" if passed else "limit violations"))
 
 
 def plot_result(r: TrajectoryResult, path: Path) -> None:
@@ -200,11 +221,13 @@ def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
 
 def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = None,
                    follow: bool = True, fps: float = 15.0, arm: str | None = None,
-                   should_stop=None, recording=None) -> TrajectoryResult:
+                   should_stop=None, recording=None, sink: EpisodeSink | None = None,
+                   seed: int = 0) -> TrajectoryResult:
     """Plan and (if ``follow``) track the task's trajectory. Raises ConfigError for bad input,
     RunFailed (with the result so far) if a phase fails; ``should_stop`` (SIGINT) ends the
     following early with the result marked ``interrupted``; ``recording``: the user's
-    RecordSettings for ``record``."""
+    RecordSettings for ``record``; ``sink``: a dataset recording the run as episode 0 (stored with
+    ``seed``)."""
     from robocfg.motion.trajectory import check_limits
 
     t_wall = time.perf_counter()
@@ -231,12 +254,20 @@ def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = N
         result.success = check.total == 0
         result.wall_time = time.perf_counter() - t_wall
         return result
-    _follow(task, params, names, plan, result, gui, record, fps, should_stop, recording)
+    _follow(task, params, names, plan, result, gui, record, fps, should_stop, recording, sink, seed)
     result.wall_time = time.perf_counter() - t_wall
     return result
 
 
-def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps, should_stop, recording=None) -> None:
+def _start(world, names: list[str], plan) -> None:
+    """Put the arm at the trajectory's first waypoint, held there."""
+    world.robot.reset_joints(names, plan.waypoints[0])
+    world.robot.command_positions(names, plan.waypoints[0])
+
+
+def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fps, should_stop, recording=None,
+            sink: EpisodeSink | None = None, seed: int = 0) -> None:
+    from robocfg.datasets.language import trajectory_instruction
     from robocfg.motion.follower import follow
     from robocfg.sim.record import Recorder
     from robocfg.sim.record_camera import CameraView
@@ -246,23 +277,36 @@ def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fp
         world.should_stop = should_stop
         result.warnings += list(world.warnings)
         robot = world.robot
-        robot.reset_joints(names, plan.waypoints[0])
-        robot.command_positions(names, plan.waypoints[0])
+        _start(world, names, plan)
         recorder = None
         if record is not None:
             base = robot.base_pose()[:3, 3]
             view = CameraView(target=(float(base[0]) + 0.3, float(base[1]), float(base[2]) + 0.4), distance=1.5)
             recorder = Recorder(world, record, fps=fps, camera=view, settings=recording)
             recorder.capture()
+        arm = robot.arm(result.arm)
+        tap = None
+        if sink is not None:  # the dataset records the run as episode 0, from the first waypoint on
+            result.warnings.append("--dataset: the arm follows the recorded actions (joint targets at the dataset "
+                                   "rate, one frame behind the plan), so the tracking error includes that lag")
+            tap = sink.begin(world, arm, None, lambda: "follow" if world.t < plan.duration else "settle",
+                             ("follow", "settle"), trajectory_instruction(len(plan.waypoints)))
         try:
             tr = follow(world, names, plan.trajectory, params.settle_time,
-                        on_step=recorder.maybe_capture if recorder is not None else None)
+                        on_step=recorder.maybe_capture if recorder is not None else None,
+                        command=lambda q, qd: arm.command(q, qd))  # looked up per call: a dataset gates it
         except RunInterrupted:
             result.interrupted = True
             return
         except RunFailed as exc:
+            if sink is not None and tap is not None:
+                tap.stop()
+                sink.end(tap, 0, seed, False, exc.phase, exc.reason)
+                tap = None
             raise RunFailed(exc.phase, exc.reason, report=result) from None
         finally:
+            if tap is not None:
+                tap.stop()
             result.sim_time = world.t
             if recorder is not None:
                 result.record = str(recorder.save())
@@ -274,3 +318,6 @@ def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fp
         }
         result.measured = {"t": _rounded(tr.t), "q": _rounded(tr.q)}
         result.success = result.limit_check["total"] == 0
+        if sink is not None and tap is not None:
+            sink.end(tap, 0, seed, result.success, None if result.success else "check",
+                     "ok" if result.success else "limit violations")

@@ -28,7 +28,7 @@ from robocfg.sim.record_camera import (
 )
 from robocfg.sim.record_overlay import FrameInfo, Marker, contact_sheet, draw_markers, draw_status
 from robocfg.sim.record_settings import RecordSettings
-from robocfg.sim.render_mirror import RenderMirror
+from robocfg.sim.render_mirror import RENDERERS, RenderMirror, make_mirror
 
 if TYPE_CHECKING:
     from robocfg.sim.world import World
@@ -213,21 +213,6 @@ class Recorder:
             write_gif(path, hold, self.fps)
         self.close()
         return path
-
-
-RENDERERS = ("auto", "tiny", "exact", "egl")
-
-
-def make_mirror(client: int, renderer: str, max_faces: int | None) -> RenderMirror:
-    """The render mirror for ``renderer`` (``"auto"``: EGL where an NVIDIA GPU is present and the
-    plugin loads, else TinyRenderer)."""
-    if renderer == "egl" or (renderer == "auto" and Path("/dev/nvidiactl").exists()):
-        try:
-            return RenderMirror(client, max_faces, egl=True)
-        except RobocfgError:
-            if renderer == "egl":
-                raise
-    return RenderMirror(client, max_faces)
 
 
 def write_gif(path: Path, frames: list[np.ndarray], fps: float) -> None:

@@ -30,6 +30,8 @@ LINK_FRAME = 4  # getLinkState index of the URDF link frame's world position (th
 GROW = 0.03  # m added around each moving link's collision box: visual meshes reach a little further
 PAD = 3  # pixels around the moving bodies' window
 POSE_TOL = 1e-6  # m / quaternion units: a baked body moved further than this is re-baked
+BACKGROUNDS = 4  # baked backgrounds kept (one per fixed camera and size; a moving camera's changes every frame)
+RENDERERS = ("auto", "tiny", "exact", "egl")  # see make_mirror; "exact": no mirror, the world's own meshes
 
 
 @dataclass
@@ -203,22 +205,31 @@ class RenderMirror:
                light_direction=(1.0, 1.0, 2.0), shadow: bool = False) -> np.ndarray:
         """RGB (H, W, 3) uint8 of the source world now, seen through PyBullet ``view``/``proj``
         matrices (column-major 16-lists) at ``size`` = (W, H) pixels."""
+        return self.render_rgbd(view, proj, size, light_direction, shadow)[0]
+
+    def render_rgbd(self, view: list[float], proj: list[float], size: tuple[int, int],
+                    light_direction=(1.0, 1.0, 2.0), shadow: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """(RGB (H, W, 3) uint8, depth buffer (H, W) float32 in PyBullet's [0, 1] form) of the
+        source world now; see :meth:`render`."""
         self.sync()
         if self.egl:
             for proxy in self.proxies.values():
                 self._place(proxy)
-            return self._draw(self.moving, view, proj, size, light_direction, shadow)[0].copy()
+            rgb, depth = self._draw(self.moving, view, proj, size, light_direction, shadow)
+            return rgb.copy(), depth.copy()
         key = (tuple(view), tuple(proj), tuple(size), tuple(light_direction), shadow)
         if key not in self._background:
-            self._background = {key: self._draw(self.static, view, proj, size, light_direction, shadow)}
+            while len(self._background) >= BACKGROUNDS:  # the oldest goes (a moving camera's, often)
+                self._background.pop(next(iter(self._background)))
+            self._background[key] = self._draw(self.static, view, proj, size, light_direction, shadow)
         bg_rgb, bg_depth = self._background[key]
         moving = [pr for pr in self.proxies.values() if pr.layer == self.moving]
         for proxy in moving:
             self._place(proxy)
-        out = bg_rgb.copy()
+        out, out_depth = bg_rgb.copy(), bg_depth.copy()
         box = self._window(moving, view, proj, size)
         if box is None:
-            return out
+            return out, out_depth
         x0, y0, x1, y1 = box
         rgb, depth = self._draw(self.moving, view, crop_projection(proj, size, box), (x1 - x0, y1 - y0),
                                 light_direction, shadow)
@@ -227,7 +238,8 @@ class RenderMirror:
             rgb, depth = self._draw(self.moving, view, proj, size, light_direction, shadow)
         near = depth < bg_depth[y0:y1, x0:x1]
         out[y0:y1, x0:x1][near] = rgb[near]
-        return out
+        out_depth[y0:y1, x0:x1][near] = depth[near]
+        return out, out_depth
 
     def _window(self, moving: list[_Proxy], view, proj, size) -> tuple[int, int, int, int] | None:
         """Pixel box (x0, y0, x1, y1), end exclusive, around the moving bodies: their links' boxes in
@@ -262,3 +274,19 @@ class RenderMirror:
                                physicsClientId=client)
         rgb = np.reshape(np.asarray(img[2], dtype=np.uint8), (h, w, 4))[:, :, :3]
         return rgb, np.reshape(np.asarray(img[3], dtype=np.float32), (h, w))
+
+
+def make_mirror(client: int, renderer: str, max_faces: int | None) -> RenderMirror:
+    """The render mirror for ``renderer`` (``"auto"``: EGL where an NVIDIA GPU is present and the
+    plugin loads, else TinyRenderer)."""
+    from pathlib import Path
+
+    from robocfg.errors import RobocfgError
+
+    if renderer == "egl" or (renderer == "auto" and Path("/dev/nvidiactl").exists()):
+        try:
+            return RenderMirror(client, max_faces, egl=True)
+        except RobocfgError:
+            if renderer == "egl":
+                raise
+    return RenderMirror(client, max_faces)

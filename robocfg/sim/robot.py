@@ -116,6 +116,12 @@ class RobotHandle:
         states = p.getJointStates(self.body_id, idx, physicsClientId=self.client)
         return np.array([s[1] for s in states], dtype=float)
 
+    def joint_states(self, names: Sequence[str]) -> tuple[list[float], list[float]]:
+        """(positions, velocities) of ``names`` from one state read, as plain lists (rad or m, rad/s
+        or m/s): for per-frame sampling, no arrays built."""
+        states = p.getJointStates(self.body_id, self.joint_indices(names), physicsClientId=self.client)
+        return [s[0] for s in states], [s[1] for s in states]
+
     def reset_joints(self, names: Sequence[str], q: Sequence[float] | np.ndarray, hold: bool = True) -> None:
         """Teleport joints to ``q`` (zero velocity) and, if ``hold``, keep their drives there."""
         for n, i, v in zip(names, self.joint_indices(names), np.asarray(q, dtype=float), strict=True):

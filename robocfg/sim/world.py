@@ -63,6 +63,9 @@ class World(SceneQueries):
         self._check_every = max(1, round(check_interval / self.dt))
         # Asked every check interval; True ends the run with RunInterrupted (SIGINT during a one-episode run).
         self.should_stop: Callable[[], bool] | None = None
+        # Called after every physics step (grippers updated, divergence checked), in order: what
+        # samples an episode whatever code steps the world (a dataset recorder, robocfg.datasets.recorder).
+        self.step_hooks: list[Callable[[], None]] = []
         self.warnings: list[str] = []
         self.bodies: dict[str, int] = {}
         self.robots: list[RobotHandle] = []
@@ -233,6 +236,11 @@ class World(SceneQueries):
         pos, orn = p.getBasePositionAndOrientation(self.body_id(name_or_id), physicsClientId=self.client)
         return np.asarray(pos), np.asarray(orn)
 
+    def body_pose_tuple(self, body: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(position m, quaternion x y z w) of body id ``body``'s base as PyBullet gives them (no
+        arrays built: for per-frame sampling)."""
+        return p.getBasePositionAndOrientation(body, physicsClientId=self.client)
+
     def body_velocity(self, name_or_id: str | int) -> tuple[np.ndarray, np.ndarray]:
         """(linear (3,) m/s, angular (3,) rad/s) velocity of a body's base, world frame."""
         lin, ang = p.getBaseVelocity(self.body_id(name_or_id), physicsClientId=self.client)
@@ -263,6 +271,8 @@ class World(SceneQueries):
                 self._check()
                 if self.should_stop is not None and self.should_stop():
                     raise RunInterrupted("simulation", "SIGINT/SIGTERM")
+            for hook in self.step_hooks:
+                hook()
 
     def snapshot(self) -> int:
         """Save the physics state (bodies, joints, contacts) to come back to with ``restore``.

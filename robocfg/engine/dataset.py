@@ -1,0 +1,78 @@
+"""The engine's side of datasets: the options every recording kind offers, the sink protocol the
+engine drives, and the scene a replay re-simulates.
+
+Recording is generic: a kind only says *when* its episode's world is ready and *what* is acted on
+(``EpisodeSession.record_from(arm, obj, phase_of)``, before its first command); the sink's tap
+then samples the episode after every physics step (a ``World.step_hooks`` entry, whatever code
+steps the world) and intercepts the arm and gripper commands (the command gate of
+:mod:`robocfg.datasets.gate`); the engine ends it with the episode's record. Replay is the same
+path the other way: the kind rebuilds episode k's world up to that point (``ReplayScene``) and the
+recorded actions drive it through the same gate.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
+
+from robocfg.engine.options import option
+
+if TYPE_CHECKING:
+    from robocfg.sim.robot import ArmHandle
+    from robocfg.sim.world import World
+
+
+@dataclass(frozen=True)
+class DatasetOptions:
+    """``--dataset*`` options of a kind that records datasets (subclass it for the kind's own
+    ``Options``; the CLI builds the sink from these fields)."""
+
+    dataset: Path | None = field(default=None, metadata=option(
+        "--dataset", help="Record the episodes into this new directory (see --dataset-format)."))
+    dataset_format: str = field(default="lerobot", metadata=option(
+        "--dataset-format", choices=("lerobot", "hdf5"),
+        help="lerobot (LeRobot v3.0: parquet + MP4) or hdf5 (robomimic layout)."))
+    dataset_fps: int = field(default=20, metadata=option(
+        "--dataset-fps", minimum=1, help="Frames per second of simulated time (must divide the physics rate)."))
+    keep: str = field(default="success", metadata=option(
+        "--keep", choices=("success", "all"), help="success: write successful episodes only; all: failures too, labelled."))
+    dataset_renderer: str = field(default="auto", metadata=option(
+        "--dataset-renderer", choices=("auto", "tiny", "exact", "egl"),
+        help="Camera images: tiny (TinyRenderer on low-poly copies, CPU), egl (PyBullet's EGL plugin, GPU), "
+             "auto (egl where an NVIDIA GPU is, else tiny) or exact (TinyRenderer on the full meshes; slowest)."))
+
+
+class EpisodeTap(Protocol):
+    """One episode being recorded (``robocfg.datasets.recorder.EpisodeRecorder``): hooked into the
+    world's steps from ``begin`` until ``stop``."""
+
+    def stop(self) -> None:
+        """Unhook from the world and give the commands back to the runner (idempotent)."""
+
+
+class EpisodeSink(Protocol):
+    """Where recorded episodes go (``robocfg.datasets.sink.DatasetSink``; a worker's shard switch).
+
+    ``begin``: the episode's world is ready — sample it from now on; ``arm`` acts, ``obj`` is the
+    body id of the object the episode is about (None: no object), ``phase_of()`` names the
+    current phase, one of ``phases``; ``language``: the episode's instruction ("" = the sink's).
+    ``end``: the episode is over (the tap is stopped) with this outcome."""
+
+    def begin(self, world: World, arm: ArmHandle, obj: int | None, phase_of: Callable[[], str],
+              phases: tuple[str, ...], language: str = "") -> EpisodeTap: ...
+
+    def end(self, tap: EpisodeTap, index: int, seed: int, success: bool, failed_phase: str | None,
+            reason: str) -> None: ...
+
+
+@dataclass
+class ReplayScene:
+    """Episode k's world as its recording began: ``arm`` to drive, ``obj`` the episode's object
+    (None: none), ``judge()`` → (success, reason) of the outcome once the actions have played."""
+
+    world: World
+    arm: ArmHandle
+    obj: int | None
+    judge: Callable[[], tuple[bool, str]]
