@@ -83,3 +83,19 @@ def test_closed_forms_match_scipy():
     for axis, angle in zip(rng.normal(size=(30, 3)), rng.uniform(-4, 4, 30), strict=True):
         ref = Rotation.from_rotvec(axis / np.linalg.norm(axis) * angle).as_matrix()
         assert np.allclose(axis_angle_matrix(axis, angle), ref, atol=1e-12)
+
+
+def test_quat_to_matrix_gives_scipys_bits_for_one_quaternion():
+    """The closed form used for single quaternions is scipy's arithmetic: the same bits, so
+    simulated runs (and golden reports) do not change with it; batches still go to scipy."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(3)
+    qs = rng.normal(size=(3000, 4))
+    qs[::2] /= np.linalg.norm(qs[::2], axis=1, keepdims=True)
+    qs[::7] = [0.0, 0.0, 0.0, 1.0] + rng.normal(size=(len(qs[::7]), 4)) * 1e-9
+    for q in qs:
+        assert np.array_equal(quat_to_matrix(q), Rotation.from_quat(q).as_matrix())
+    assert np.array_equal(quat_to_matrix(qs[:5]), Rotation.from_quat(qs[:5]).as_matrix())
+    with pytest.raises(ValueError):
+        quat_to_matrix([0.0, 0.0, 0.0, 0.0])

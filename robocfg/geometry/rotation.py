@@ -13,16 +13,32 @@ forms are tested against scipy's ``Rotation``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
 
 
 def quat_to_matrix(q: Sequence[float] | np.ndarray) -> np.ndarray:
-    """3x3 rotation of a quaternion ``(x, y, z, w)`` (normalised first)."""
+    """3x3 rotation of a quaternion ``(x, y, z, w)`` (normalised first); (N, 3, 3) for (N, 4).
+
+    One quaternion is converted in closed form with scipy's own arithmetic (the same bits as
+    ``Rotation.from_quat(q).as_matrix()``, tested; ≈ 5× cheaper: it runs for every link pose
+    read while simulating)."""
+    a = np.asarray(q, dtype=float)
+    if a.shape == (4,):
+        x, y, z, w = a.tolist()
+        n = math.sqrt(x * x + y * y + z * z + w * w)
+        if n > 0.0 and math.isfinite(n):
+            x, y, z, w = x / n, y / n, z / n, w / n
+            x2, y2, z2, w2 = x * x, y * y, z * z, w * w
+            xy, zw, xz, yw, yz, xw = x * y, z * w, x * z, y * w, y * z, x * w
+            return np.array([[x2 - y2 - z2 + w2, 2 * (xy - zw), 2 * (xz + yw)],
+                             [2 * (xy + zw), -x2 + y2 - z2 + w2, 2 * (yz - xw)],
+                             [2 * (xz - yw), 2 * (yz + xw), -x2 - y2 + z2 + w2]])
     from scipy.spatial.transform import Rotation
 
-    return Rotation.from_quat(np.asarray(q, dtype=float)).as_matrix()
+    return Rotation.from_quat(a).as_matrix()
 
 
 def matrix_to_quat(R: np.ndarray) -> np.ndarray:

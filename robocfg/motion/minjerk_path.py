@@ -19,12 +19,28 @@ PEAK_ACCEL = 5.7735  # max |d²s/dτ²| of the min-jerk law
 SAMPLES = 64
 
 
+class _Segment:
+    """The straight joint path W0 + s·(W1 − W0), s ∈ [0, 1], called like a ``CubicSpline``:
+    ``path(s, order)``. Bit for bit what ``CubicSpline`` gives for two waypoints clamped to the
+    chord's slope (its cubic and quadratic coefficients are exactly 0), without building one."""
+
+    def __init__(self, W: np.ndarray):
+        self.start, self.delta = W[0], W[1] - W[0]
+
+    def __call__(self, s, order: int = 0) -> np.ndarray:
+        s = np.asarray(s, dtype=float)
+        if order == 0:
+            return s[..., None] * self.delta + self.start
+        if order == 1:
+            return np.broadcast_to(self.delta, (*s.shape, len(self.delta))).copy()
+        return np.zeros((*s.shape, len(self.delta)))
+
+
 class MinJerkPath(Trajectory):
-    """q(t) = spline(s(t / T)), rest to rest, through ``waypoints`` (k, n) with k ≥ 2."""
+    """q(t) = spline(s(t / T)), rest to rest, through ``waypoints`` (k, n) with k ≥ 2 (two: the
+    straight segment, no spline built)."""
 
     def __init__(self, waypoints: np.ndarray, limits: JointLimits, min_duration: float = 0.05):
-        from scipy.interpolate import CubicSpline
-
         W = np.asarray(waypoints, dtype=float)
         seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
         keep = np.concatenate([[True], seg > 1e-9])
@@ -34,15 +50,19 @@ class MinJerkPath(Trajectory):
             seg = np.array([1.0])
         else:
             seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
-        knots = np.concatenate([[0.0], np.cumsum(seg)])
-        knots /= knots[-1]
         self.waypoints = W
-        self.spline = CubicSpline(knots, W, axis=0, bc_type="not-a-knot" if len(W) > 3 else "natural")
         if len(W) == 2:  # a straight segment: linear in s
-            self.spline = CubicSpline(knots, W, axis=0, bc_type=((1, W[1] - W[0]), (1, W[1] - W[0])))
-        s = np.linspace(0.0, 1.0, SAMPLES)
-        d1 = np.abs(self.spline(s, 1)).max(axis=0)
-        d2 = np.abs(self.spline(s, 2)).max(axis=0)
+            self.spline = _Segment(W)
+            d1, d2 = np.abs(W[1] - W[0]), np.zeros(W.shape[1])
+        else:
+            from scipy.interpolate import CubicSpline
+
+            knots = np.concatenate([[0.0], np.cumsum(seg)])
+            knots /= knots[-1]
+            self.spline = CubicSpline(knots, W, axis=0, bc_type="not-a-knot" if len(W) > 3 else "natural")
+            s = np.linspace(0.0, 1.0, SAMPLES)
+            d1 = np.abs(self.spline(s, 1)).max(axis=0)
+            d2 = np.abs(self.spline(s, 2)).max(axis=0)
         t_vel = PEAK_SPEED * np.max(d1 / limits.velocity)
         t_acc = np.sqrt(np.max((d2 * PEAK_SPEED**2 + d1 * PEAK_ACCEL) / limits.acceleration))
         self.duration = float(max(t_vel, t_acc, min_duration))
