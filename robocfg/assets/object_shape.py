@@ -109,6 +109,16 @@ class ObjectShape:
                 best = top if best is None else max(best, top)
         return best
 
+    def fixed_surface(self, count: int) -> np.ndarray:
+        """``surface(count, default_rng(0))``'s points (body frame, m), drawn once per shape and
+        count: the same fixed sample every time it is asked for (read-only)."""
+        cache: dict[int, np.ndarray] = self.__dict__.setdefault("_fixed_surface", {})
+        if count not in cache:
+            pts = self.surface(count, np.random.default_rng(0))[0]
+            pts.setflags(write=False)
+            cache[count] = pts
+        return cache[count]
+
     def surface(self, count: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """``count`` points spread over the parts' surfaces (area-weighted) and their outward unit
         normals, body frame: the object's own point cloud, no camera needed."""

@@ -62,7 +62,7 @@ class LyingObject:
     def surface_points(self) -> np.ndarray:
         """Points spread over the surface, world frame (m): a fixed sample (same object ⇒ same
         points), for collision tests that vertices alone would miss (a box face)."""
-        pts, _ = self.shape.surface(SURFACE_CHECK_POINTS, np.random.default_rng(0))
+        pts = self.shape.fixed_surface(SURFACE_CHECK_POINTS)
         return np.concatenate([pts @ self.rotation.T + self.position, self.points()])
 
     @property

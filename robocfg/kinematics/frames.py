@@ -39,7 +39,9 @@ def grasp_rotation(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
     if n < 1e-9:
         raise ValueError("closing direction is parallel to the approach direction")
     y /= n
-    return np.column_stack([x, y, np.cross(x, y)])
+    (x0, x1, x2), (y0, y1, y2) = x.tolist(), y.tolist()
+    z = [x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0]  # x × y, np.cross's arithmetic without its overhead
+    return np.column_stack([x, y, z])
 
 
 def grasp_side_shift(arm: ArmConfig, width: float) -> float:

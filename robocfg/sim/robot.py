@@ -191,7 +191,10 @@ class RobotHandle:
 
     def _drive_list(self, key: tuple[str, ...]) -> object:
         """A token that changes whenever a drive of ``key`` is replaced (the fast path's cache key)."""
-        return self._drive_tokens.setdefault(key, object())
+        token = self._drive_tokens.get(key)
+        if token is None:  # (setdefault would make a new object every step)
+            token = self._drive_tokens[key] = object()
+        return token
 
     def set_drive(self, name: str, drive: Drive) -> None:
         """Install a drive with explicit settings (used by grippers) and send it."""
