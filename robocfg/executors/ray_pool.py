@@ -1,11 +1,12 @@
 """``--executor ray``: the same batches as ``--workers``, run by Ray actors (one CPU each).
 
 Each actor opens the recipe once (its world lives as long as the actor) and runs the batches it
-is given as actor calls; the driver keeps one call in flight per actor and hands the next batch
-to whichever actor returns first. Dataset shards are written by the actors under the dataset
+is given as actor calls; the driver keeps ``IN_FLIGHT`` calls queued per actor (an actor runs
+them in order, so it starts its next batch without waiting for the driver to collect the last
+one and send another) and hands the next batch to whichever actor returns. Dataset shards are written by the actors under the dataset
 folder, so on a cluster that folder must be on a filesystem every node shares (see
 ``docs/scale-out.md``); the driver merges them. An actor that dies (node lost, process killed)
-surfaces as ``RayActorError`` on its call: that batch is reported lost and the others go on.
+surfaces as ``RayActorError`` on its calls: those batches are reported lost and the others go on.
 
 Where Ray runs: ``address`` (``--ray-address``), else ``RAY_ADDRESS``, else a local Ray started
 here and shut down after the run. A Ray already initialised in this process (a test, a notebook)
@@ -31,6 +32,8 @@ from robocfg.executors.session import (
     report_in_driver,
     run_batch,
 )
+
+IN_FLIGHT = 2  # actor calls queued per actor: it never waits for the driver between batches
 
 
 class _Actor:
@@ -83,8 +86,9 @@ class RayPool:
                 inflight[actor.run.remote(batch)] = (actor, batch)
 
         try:
-            for a in self.actors:
-                hand_out(a)
+            for _ in range(IN_FLIGHT):
+                for a in self.actors:
+                    hand_out(a)
             while inflight:
                 if should_stop is not None and should_stop() and todo:
                     result.interrupted = True
