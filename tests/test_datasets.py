@@ -267,3 +267,26 @@ def test_dataset_cameras_through_the_render_mirror_look_like_the_exact_render(tm
     d_exact, d_fast = exact["wrist"].depth, fast["wrist"].depth
     assert d_exact is not None and d_fast is not None
     assert np.median(np.abs(d_exact - d_fast)) < 0.005
+
+
+def test_an_episode_that_raises_leaves_no_recorder_hooked(tmp_path):
+    """The engine stops the episode's recorder whatever ends the episode: after an exception the
+    world has no step hook left and the arm's commands reach the drives again."""
+    from robocfg.engine import RunOptions, open_session
+
+    task = load_task(ROOT / "robocfg/data/tasks/pick_place.yaml")
+    sink = DatasetSink(tmp_path / "ds", "lerobot", task, renderer="exact", extra_info={"task_path": str(task.path)})
+    with open_session(task, RunOptions(seed=0, sink=sink)) as session:
+        arm = session.world.robot.arm()
+
+        def failing(k, recorder):
+            session.record_from(arm, None, lambda: "setup")
+            assert session.world.step_hooks and "command" in arm.__dict__  # recording: the gate has the arm
+            session.world.step(3)
+            raise RuntimeError("boom")
+
+        session.episode = failing
+        with pytest.raises(RuntimeError, match="boom"):
+            session.run(0)
+        assert session.world.step_hooks == [] and "command" not in arm.__dict__
+    assert sink.close().episodes_run == 0  # an episode that raised is not written
