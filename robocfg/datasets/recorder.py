@@ -68,6 +68,11 @@ class EpisodeRecorder:
         self.images: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras}
         self.depth: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras if c.depth}
 
+    @property
+    def lag_steps(self) -> int:
+        """Physics steps the command gate delays the runner's commands by: one frame."""
+        return self.n
+
     def start(self) -> None:
         """Frame 0 now; from here every physics step of the world is sampled."""
         self.gate.install()

@@ -48,6 +48,13 @@ class EpisodeTap(Protocol):
     """One episode being recorded (``robocfg.datasets.recorder.EpisodeRecorder``): hooked into the
     world's steps from ``begin`` until ``stop``."""
 
+    @property
+    def lag_steps(self) -> int:
+        """Physics steps by which the runner's commands reach the drives late while recorded
+        (one dataset frame: the command gate). A runner that knows its future commands (a
+        planned trajectory) can send them this much ahead."""
+        ...
+
     def stop(self) -> None:
         """Unhook from the world and give the commands back to the runner (idempotent)."""
 

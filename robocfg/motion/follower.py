@@ -61,11 +61,13 @@ class Tracking:
 
 def follow(world, names: list[str], traj: Trajectory, settle_time: float = 0.25, mode: str = "matched",
            on_step: Callable[[], None] | None = None,
-           command: Callable[[np.ndarray, np.ndarray], None] | None = None) -> Tracking:
+           command: Callable[[np.ndarray, np.ndarray], None] | None = None, lead: int = 0) -> Tracking:
     """Play ``traj`` on the world's first robot, joints ``names``; the robot should be at the
     trajectory's start. ``on_step`` runs after every physics step (e.g. a recorder); ``command(q,
     q̇)`` sends the targets (default: the robot's position drives of ``names``; an arm's
-    ``command`` lets a dataset recording intercept them)."""
+    ``command`` lets a dataset recording intercept them); ``lead``: send the reference that many
+    physics steps ahead, for a ``command`` that delays by as much (a dataset's command gate: one
+    frame), so the arm still follows the plan on time."""
     if mode not in ("matched", "next"):
         raise ValueError(f"unknown follower mode {mode!r}")
     robot, dt = world.robot, float(world.dt)
@@ -76,10 +78,13 @@ def follow(world, names: list[str], traj: Trajectory, settle_time: float = 0.25,
     q_ref, qd_ref, _ = traj.evaluate(times)  # clipped to the end time
     ts, qs, errs = [0.0], [robot.joint_positions(names)], [robot.joint_positions(names) - q_ref[0]]
     for k in range(n_steps):
-        if mode == "matched":
-            send(q_ref[k], (q_ref[k + 1] - q_ref[k]) / dt)
+        j = k + lead  # k itself without a lead
+        if j >= n_steps:  # led past the end: hold the last point
+            send(q_ref[n_steps], np.zeros(len(names)))
+        elif mode == "matched":
+            send(q_ref[j], (q_ref[j + 1] - q_ref[j]) / dt)
         else:
-            send(q_ref[k + 1], qd_ref[k + 1])
+            send(q_ref[j + 1], qd_ref[j + 1])
         world.step()
         if on_step is not None:
             on_step()

@@ -288,13 +288,15 @@ def _follow(task, params, names, plan, result: TrajectoryResult, gui, record, fp
         tap = None
         if sink is not None:  # the dataset records the run as episode 0, from the first waypoint on
             result.warnings.append("--dataset: the arm follows the recorded actions (joint targets at the dataset "
-                                   "rate, one frame behind the plan), so the tracking error includes that lag")
+                                   "rate, ramped linearly between frames; the plan is sent one frame ahead to make up "
+                                   "for the frame they lag), so the tracking error includes that ramp")
             tap = sink.begin(world, arm, None, lambda: "follow" if world.t < plan.duration else "settle",
                              ("follow", "settle"), trajectory_instruction(len(plan.waypoints)))
         try:
             tr = follow(world, names, plan.trajectory, params.settle_time,
                         on_step=recorder.maybe_capture if recorder is not None else None,
-                        command=lambda q, qd: arm.command(q, qd))  # looked up per call: a dataset gates it
+                        command=lambda q, qd: arm.command(q, qd),  # looked up per call: a dataset gates it
+                        lead=tap.lag_steps if tap is not None else 0)
         except RunInterrupted:
             result.interrupted = True
             return
