@@ -167,3 +167,21 @@ def test_missing_inertial_gets_link_mass(tmp_path):
     with World(task) as w:
         r = w.robot
         assert p.getDynamicsInfo(r.body_id, r.link("carriage"), physicsClientId=w.client)[0] == pytest.approx(0.3)
+
+
+def test_a_body_spawned_again_reuses_its_shapes(tmp_path):
+    """PyBullet never frees a created shape: the object re-spawned every episode must reuse its
+    collision and visual shapes (one cache entry per distinct shape, size, mesh and colour)."""
+    task = make_task(tmp_path, PANDA)
+    with World(task) as w:
+        ball = Body(name="ball", shape="sphere", size=[0.03], mass=0.1, position=[0.5, -0.3, 0.03])
+        first = w.shape_cache.shapes(w.client, ball, tmp_path)
+        for _ in range(5):
+            w.add_body(ball)
+            w.step(2)
+            w.remove_body("ball")
+        assert w.shape_cache.shapes(w.client, ball, tmp_path) == first and len(w.shape_cache) == 1
+        w.add_body(ball.model_copy(update={"color": [0.1, 0.2, 0.3, 1.0]}))
+        w.add_body(ball.model_copy(update={"name": "big", "size": [0.05]}))
+        assert len(w.shape_cache) == 3
+        assert np.allclose(w.body_pose("big")[0], [0.5, -0.3, 0.03])

@@ -29,8 +29,8 @@ def run_distributed(checked: Any, options: Any, workers: int, executor: str, ray
     pool = _executor(executor, workers, ray_address)
     t0 = time.perf_counter()
     try:
-        execution = pool.run(recipe, plan_batches(options.episodes, pool.workers, target is not None),
-                             options.on_episode, options.should_stop)
+        execution = pool.run(recipe, _missing(plan_batches(options.episodes, pool.workers, target is not None),
+                                              options.resumed), options.on_episode, options.should_stop)
     except BaseException:
         if target is not None:
             shutil.rmtree(target.root / ".shards", ignore_errors=True)
@@ -40,7 +40,22 @@ def run_distributed(checked: Any, options: Any, workers: int, executor: str, ray
     if target is not None:
         options = dataclasses.replace(options, sink=MergedShards(execution.shards, target.root, target.fmt,
                                                                  target.extra_info))
-    return RunOutput(execution.report, timing), options, execution.lost
+    report = execution.report
+    if options.resumed:  # the report of every finished episode, those of the interrupted run included
+        from robocfg.executors.session import report_in_driver
+
+        records = sorted([*options.resumed, *(r.record for r in runs)], key=lambda r: int(r.index))
+        report = report_in_driver(recipe, records, execution.interrupted)
+    return RunOutput(report, timing), options, execution.lost
+
+
+def _missing(batches: list[Any], resumed: tuple[Any, ...]) -> list[Any]:
+    """The batches without the episodes a resumed run already has (``--resume``)."""
+    from robocfg.executors.session import Batch
+
+    done = {int(r.index) for r in resumed}
+    kept = (Batch(b.id, tuple(k for k in b.indices if k not in done)) for b in batches)
+    return [b for b in kept if b.indices]
 
 
 def _executor(kind: str, workers: int, address: str | None):

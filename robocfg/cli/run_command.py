@@ -44,18 +44,25 @@ class CliHook:
 HOOKS: dict[str, CliHook] = {}
 
 
-def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Parameter]:
+def _common_parameters(kind: str, command: str, verb: str, episodic: bool) -> list[inspect.Parameter]:
     def opt(name: str, annotation: Any, default: Any) -> inspect.Parameter:
         return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, annotation=annotation, default=default)
 
+    resume = [opt("resume", Annotated[Path | None, typer.Option(
+        "--resume", metavar="REPORT", dir_okay=False,
+        help="Finish the interrupted run whose --json report this is: run only its missing episodes and "
+             "write the whole report (to --json, else over REPORT). --seed, --arm and -n default to the "
+             "report's; anything else that differs is refused.")], None)] if episodic else []
     return [
         opt("task", Annotated[str, typer.Argument(help=f"Task name or YAML path (a 'task: {kind}' file).",
                                                   autocompletion=task_names(kind))], kind),
         opt("robot", RobotOpt, None),
         opt("arm", Annotated[str | None, typer.Option("--arm", help="Arm to use on a multi-arm robot (default: the first).")], None),
         opt("seed", SeedOpt, None),
-        opt("episodes", Annotated[int, typer.Option("--episodes", "-n", min=1,
-                                                    help="Number of seeded episodes (episode k: rng([seed, k])).")], 1),
+        opt("episodes", Annotated[int | None, typer.Option("--episodes", "-n", min=1, show_default=False,
+                                                           help="Number of seeded episodes (episode k: rng([seed, k])); "
+                                                                "default 1.")],
+            None),
         opt("json_path", JsonOpt, None),
         opt("record", RecordOpt, None),
         opt("record_episode", Annotated[int, typer.Option("--record-episode", min=0, help="Which episode --record films.")], 0),
@@ -70,6 +77,7 @@ def _common_parameters(kind: str, command: str, verb: str) -> list[inspect.Param
         opt("workers", WorkersOpt, None),
         opt("executor", ExecutorOpt, "local"),
         opt("ray_address", RayAddressOpt, None),
+        *resume,
     ]
 
 
@@ -125,7 +133,7 @@ def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
     from robocfg.engine.registry import command_name
 
     command = command_name(runner.kind)
-    params = _common_parameters(runner.kind, command, runner.verb) + _kind_parameters(runner.Options)
+    params = _common_parameters(runner.kind, command, runner.verb, runner.episodic) + _kind_parameters(runner.Options)
 
     def run_kind(**kw: Any) -> int:
         extras = None
@@ -141,11 +149,12 @@ def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
 
 
 def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm: str | None, seed: int | None,
-            episodes: int, json_path: Path | None, record: Path | None, record_episode: int, gui: bool,
+            episodes: int | None, json_path: Path | None, record: Path | None, record_episode: int, gui: bool,
             quiet: bool, min_success: float, extras: Any, set_: list[str] | None = None, camera: str | None = None,
             size: str | None = None, fps: float | None = None, workers: int | None = None, executor: str = "local",
-            ray_address: str | None = None) -> int:
-    """Check, run, write and print one ``run <kind>``; the exit code (0, 1 or 130)."""
+            ray_address: str | None = None, resume: Path | None = None) -> int:
+    """Check, run, write and print one ``run <kind>``; the exit code (0, 1 or 130). ``episodes``
+    None: 1, or with ``resume`` (a partial report) the interrupted run's count."""
     from robocfg.cli.common import console, load_task_for, write_json
     from robocfg.cli.episodes import (
         check_record_episode,
@@ -154,6 +163,14 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
         stop_on_signals,
     )
     from robocfg.cli.executor_opts import resolve_workers
+    from robocfg.cli.resume import (
+        read_partial,
+        refuse_with_resume,
+        resume_block,
+        resume_output,
+        resumed_options,
+        with_resume_block,
+    )
     from robocfg.cli.run_print import print_report
     from robocfg.cli.set_option import overrides
     from robocfg.engine.dataset import DatasetOptions
@@ -165,7 +182,13 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     from robocfg.sim.quiet import quiet_import
 
     kind = runner_type.kind
+    partial = read_partial(resume, runner_type) if resume is not None else None
+    episodes_given = episodes is not None
+    episodes = episodes if episodes is not None else partial.block.episodes if partial is not None else 1
     check_record_episode(record_episode, episodes, record is not None)
+    if partial is not None:
+        refuse_with_resume(partial, record, record_episode, extras)
+        json_path = json_path if json_path is not None else resume_output(partial)
     recording = record_settings(camera, size, fps, record is not None)
     n_workers = resolve_workers(workers, episodes, executor, gui)
     distributed = runner_type.episodic and (n_workers > 1 or executor == "ray")
@@ -175,6 +198,8 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     log = None if quiet or episodes > 1 else (lambda msg: out.print(msg, markup=False))
     options = RunOptions(seed=seed, episodes=episodes, arm=arm, gui=gui, record=record, record_episode=record_episode,
                          recording=recording, extras=extras, log=log)
+    if partial is not None:
+        options = resumed_options(partial, runner_type, checked, options, episodes_given)
     runner = runner_type(checked, options)
     runner.check()  # exit 2 before anything is simulated
     hook = HOOKS.get(kind)
@@ -189,6 +214,9 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     with stop_on_signals() as stop, \
             progress_bar(command_name(kind), episodes, runner_type.verb, episodes > 1 and not quiet) as tick:
         runner.options = dataclasses.replace(runner.options, on_episode=tick, should_stop=stop)
+        for done in runner.options.resumed:  # the bar counts the episodes of the interrupted run too
+            if tick is not None:
+                tick(done)
         try:
             if distributed:
                 from robocfg.cli.parallel import run_distributed
@@ -208,7 +236,9 @@ def execute(runner_type: type[TaskRunner], *, task: str, robot: str | None, arm:
     extra_lines = hook.finish(runner.options, output.report) if hook is not None else []
     from robocfg.cli.parallel import lost_lines, with_lost
 
-    write_json(json_path, with_lost(output.report, lost))
+    block = resume_block(runner_type, checked, runner.options) if runner_type.episodic and output.report.interrupted \
+        else None
+    write_json(json_path, with_resume_block(with_lost(output.report, lost), block))
     print_report(output.report, output.timing, quiet, record, extra_lines)
     for line in lost_lines(lost):
         console(stderr=True).print(line, markup=False)

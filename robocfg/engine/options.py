@@ -85,13 +85,15 @@ class RunOptions:
     should_stop: Callable[[], bool] | None = None  # True once the run is asked to stop (SIGINT/SIGTERM)
     log: Callable[[str], None] | None = None  # phase log of episode 0 (one line per phase)
     sink: EpisodeSink | None = None  # a dataset sink (``robocfg.datasets.sink.DatasetSink``) recording every episode
+    resumed: tuple[Any, ...] = ()  # records of episodes an interrupted run finished: not run again, reported
 
     def resolved_seed(self, task_seed: int) -> int:
         return task_seed if self.seed is None else self.seed
 
     def portable(self) -> RunOptions:
         """A copy without the in-process hooks (callbacks, recorder factory, sink): picklable."""
-        return dataclasses.replace(self, recorder=None, on_episode=None, should_stop=None, log=None, sink=None)
+        return dataclasses.replace(self, recorder=None, on_episode=None, should_stop=None, log=None, sink=None,
+                                   resumed=())
 
     def stop_requested(self) -> bool:
         return self.should_stop is not None and bool(self.should_stop())

@@ -201,16 +201,33 @@ class EpisodeSession(ABC, Generic[RecordT]):
 
 def run_batch(session: EpisodeSession[RecordT], options: RunOptions) -> tuple[list[RecordT], bool]:
     """Episodes 0 .. ``options.episodes`` − 1 in order; before each, ``should_stop`` may end the
-    batch (then the second value, ``interrupted``, is True). ``on_episode`` sees every record."""
+    batch (then the second value, ``interrupted``, is True). ``on_episode`` sees every record run.
+    Episodes in ``options.resumed`` (records of an interrupted run) are not run again: their records
+    take their places in the returned list (index order), stopped or not."""
+    done = resumed_by_index(options)
     records: list[RecordT] = []
     for k in range(options.episodes):
+        if k in done:
+            records.append(done[k])
+            continue
         if options.stop_requested():
-            return records, True
+            return records + [done[j] for j in sorted(done) if j > k], True
         record = session.run(k)
         records.append(record)
         if options.on_episode is not None:
             options.on_episode(record)
     return records, False
+
+
+def resumed_by_index(options: RunOptions) -> dict[int, Any]:
+    """``options.resumed`` by episode index (``ValueError`` on an index run twice or out of range)."""
+    done: dict[int, Any] = {}
+    for r in options.resumed:
+        k = int(r.index)
+        if k in done or not 0 <= k < options.episodes:
+            raise ValueError(f"resumed episode {k}: {'given twice' if k in done else 'not in 0..' + str(options.episodes - 1)}")
+        done[k] = r
+    return done
 
 
 class SingleRunSession:

@@ -12,7 +12,7 @@ from robocfg.engine.session import BatchTiming
 from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, failed_episodes_line
 
 
-@dataclass
+@dataclass(slots=True)
 class AttemptRecord:
     """One grasp attempt: the candidate tried (GraspNet frame, world m), and how it ended."""
 
@@ -23,7 +23,7 @@ class AttemptRecord:
     reason: str
 
 
-@dataclass
+@dataclass(slots=True)
 class GraspEpisode:
     """One episode. ``object_start``: x, y, z (m) where the object was spawned, ``object_start_yaw_deg``
     the yaw added by the randomisation; ``rejected``: candidate counts per

@@ -12,7 +12,7 @@ from robocfg.runners.report_schema import REPORT_SCHEMA_VERSION, failed_episodes
 PHASES = ("pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
 
 
-@dataclass
+@dataclass(slots=True)
 class PhaseRecord:
     """One phase: simulated start/end time (s), whether it converged, and why not."""
 
@@ -23,7 +23,7 @@ class PhaseRecord:
     detail: str = ""
 
 
-@dataclass
+@dataclass(slots=True)
 class EpisodeResult:
     """One episode. Positions in m (world), angles in deg."""
 

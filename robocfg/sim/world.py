@@ -33,7 +33,7 @@ from robocfg.config.scene import Body
 from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
-from robocfg.sim.bodies import spawn_body, spawn_ground, spawn_pedestal, spawn_table
+from robocfg.sim.bodies import ShapeCache, spawn_body, spawn_ground, spawn_pedestal, spawn_table
 from robocfg.sim.gripper import make_gripper
 from robocfg.sim.loading import load_robot_urdf
 from robocfg.sim.mimic import MimicGears
@@ -68,6 +68,7 @@ class World(SceneQueries):
         self.step_hooks: list[Callable[[], None]] = []
         self.warnings: list[str] = []
         self.bodies: dict[str, int] = {}
+        self.shape_cache = ShapeCache()  # shapes of bodies added per episode, reused (PyBullet never frees them)
         self.robots: list[RobotHandle] = []
         self.mimic: dict[int, MimicGears] = {}
         self._dynamic: list[int] = []
@@ -212,7 +213,7 @@ class World(SceneQueries):
         """Spawn a box/sphere/cylinder/capsule/mesh body and register it under ``body.name``."""
         if body.name in self.bodies:
             self.remove_body(body.name)
-        bid = spawn_body(self.client, body, self.task.path.parent, static=static)
+        bid = spawn_body(self.client, body, self.task.path.parent, static=static, cache=self.shape_cache)
         self._register(body.name, bid, dynamic=not static and body.mass > 0)
         self._warn_overlap(body.name)
         return bid
