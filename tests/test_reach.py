@@ -45,6 +45,8 @@ def test_validate_warns_and_run_fails_before_simulating(tmp_path, capsys, monkey
     code, out, err = run_main(["run", "pick-place", str(path), "-n", "2", "-q", "--json", str(out_json)], capsys, monkeypatch)
     assert code == 1
     assert "pre_grasp: the pose above the object is unreachable, out of the arm's reach" in out
+    warned = [line for line in err.splitlines() if "warning:" in line]
+    assert warned and all(line.count("warning:") == 1 for line in warned), err  # said once per line
     report = json.loads(out_json.read_text())
     assert [e["failed_phase"] for e in report["episodes"]] == ["pre_grasp", "pre_grasp"]
     assert all(e["steps"] == 0 for e in report["episodes"])  # nothing was simulated

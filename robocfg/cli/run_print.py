@@ -9,11 +9,20 @@ from typing import Any
 from robocfg.cli.common import console, key_value_table
 
 
+def _is_problem(line: str) -> bool:
+    """A warning formatted as a problem (``FILE:LINE:COL: field: warning: message``) says so itself."""
+    return ": warning: " in line
+
+
+def _warning(line: str) -> str:
+    return line if _is_problem(line) else f"warning: {line}"
+
+
 def print_report(report: Any, timing: Any, quiet: bool, record: Path | None, extra_lines: list[str]) -> None:
     out, err = console(), console(stderr=True)
     if quiet:
         for w in report.view(timing).warnings:
-            err.print(f"warning: {w}", markup=False)
+            err.print(_warning(w), markup=False)
         out.print(report.summary_line(timing), markup=False)
         for line in report.failure_lines():
             out.print(f"  {line}", markup=False)
@@ -23,7 +32,7 @@ def print_report(report: Any, timing: Any, quiet: bool, record: Path | None, ext
 
     view = report.view(timing)
     for w in view.warnings:
-        out.print(f"[yellow]warning:[/yellow] {escape(w)}")
+        out.print(escape(w) if _is_problem(w) else f"[yellow]warning:[/yellow] {escape(w)}")
     for n in view.notes:
         out.print(f"note: {n}", markup=False)
     rows = list(view.rows)
