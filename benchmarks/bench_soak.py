@@ -7,7 +7,7 @@ sample of successes) is reproduced exactly by the per-episode API in a fresh ses
 One session (one world, restored before each episode) runs episodes 0 .. N−1 exactly as
 ``robocfg run pick-place -n N`` does. Memory: the peak resident set size (VmHWM) after the
 warm-up episodes against the peak at the end (goal: growth < 5 %), with the current RSS sampled
-along the way. Reproduction: each failed episode, and ``--check`` successful ones spread over the
+along the way (its growth per episode after the warm-up is printed too). Reproduction: each failed episode, and ``--check`` successful ones spread over the
 run, is run again alone with ``run_episode(EpisodeSpec(task, seed, k))`` in a new world; its record
 must equal the batch's record field for field (goal: all equal).
 """
@@ -64,6 +64,8 @@ def main() -> None:
     wall = time.perf_counter() - t0
     hwm_end = _status_kib("VmHWM")
     growth = (hwm_end - hwm_warm) / hwm_warm
+    after = [(k, v) for k, v in trace if k >= warmup]
+    slope = ((after[-1][1] - after[0][1]) / (after[-1][0] - after[0][0])) if len(after) > 1 else 0.0  # KiB/episode
 
     failed = [r.index for r in records if not r.success]
     ok = [r.index for r in records if r.success]
@@ -85,12 +87,14 @@ def main() -> None:
         "rss_start_mib": round(rss_start / 1024, 1), "peak_rss_after_warmup_mib": round(hwm_warm / 1024, 1),
         "peak_rss_end_mib": round(hwm_end / 1024, 1), "peak_rss_growth": round(growth, 4), "warmup": warmup,
         "rss_trace_mib": [(k, round(v / 1024, 1)) for k, v in trace],
+        "rss_growth_kib_per_episode_after_warmup": round(slope, 2),
         "reproduced_alone": checked, "mismatched": mismatched,
     }
     print(f"soak: {args.episodes} episodes of {args.task} ({result['robot']}), seed {args.seed}: "
           f"{len(ok)} placed, {len(failed)} failed, {wall:.0f} s ({result['wall_per_episode_s']:.3f} s/episode)")
     print(f"peak RSS after {warmup} episodes {hwm_warm / 1024:.1f} MiB, at the end {hwm_end / 1024:.1f} MiB: "
-          f"growth {growth:+.2%} (goal < 5 %: {'met' if growth < 0.05 else 'NOT met'})")
+          f"growth {growth:+.2%} (goal < 5 %: {'met' if growth < 0.05 else 'NOT met'}); RSS after the warm-up "
+          f"{slope:+.1f} KiB per episode")
     print(f"reproduced alone in a new world: {len(checked) - len(mismatched)}/{len(checked)} identical "
           f"(episodes {checked}; every failure among them: {len(failed)})")
     if args.json:
