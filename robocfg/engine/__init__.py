@@ -18,7 +18,8 @@ Modules: ``options`` (:class:`RunOptions`, a kind's own ``option(...)`` fields),
 (the :class:`TaskRunner` protocol and the report view), ``registry`` (``@register_task``,
 ``runner_for``), ``session`` (:class:`EpisodeSession`: world build, snapshot/restore, episode
 rng, recording hook, timing; :func:`run_batch`), ``randomize`` (the seeded body randomisation
-every kind shares), ``spec`` (:class:`EpisodeSpec`, :func:`run_episode`, :func:`open_session`).
+every kind shares), ``spec`` (:class:`EpisodeSpec`, :func:`run_episode`, :func:`open_session`),
+``records`` (episode records read back from a ``--json`` report, for ``--resume``).
 """
 
 from __future__ import annotations
