@@ -33,6 +33,19 @@ def test_two_workers_give_the_report_and_dataset_of_one(fmt, episodes, tmp_path,
         assert a[name] == b[name], f"{name} differs"  # videos, parquet and HDF5 byte for byte
 
 
+def test_grasp_datasets_are_the_same_on_two_workers(tmp_path, capsys, monkeypatch):
+    """The engine records every kind the same way, so a grasp run's report and dataset (one
+    instruction per episode's object) do not depend on the worker count either."""
+    common = ["run", "grasp", "-n", "2", "--seed", "5", "--dataset-fps", FPS, "--keep", "all"]
+    one = run_json([*common, "--workers", "1", "--dataset", str(tmp_path / "one")], tmp_path, "one", capsys, monkeypatch)
+    two = run_json([*common, "--workers", "2", "--dataset", str(tmp_path / "two")], tmp_path, "two", capsys, monkeypatch)
+    assert one == two
+    a, b = files_of(tmp_path / "one"), files_of(tmp_path / "two")
+    assert list(a) == list(b) and "meta/tasks.parquet" in a
+    for name in a:
+        assert a[name] == b[name], f"{name} differs"
+
+
 def test_a_killed_worker_is_reported_with_its_episodes_and_the_run_ends(tmp_path):
     """kill -9 of one worker mid-run: exit 1, the JSON holds every other episode and names the
     lost ones with the signal; nothing hangs (the timeout would fail the test)."""
