@@ -18,12 +18,25 @@ def _warning(line: str) -> str:
     return line if _is_problem(line) else f"warning: {line}"
 
 
+_STATUS_HEADS = ("ok", "failed", "FAILED", "not reached")
+
+
+def summary_line(report: Any, timing: Any) -> str:
+    """The report's one line; an interrupted run's says ``interrupted`` where the line would say
+    ``ok`` or ``failed`` of the episodes that finished (0/0 placed is no success)."""
+    line = report.summary_line(timing)
+    if not report.interrupted:
+        return line
+    head, sep, rest = line.partition(": ")
+    return f"interrupted: {rest}" if sep and head in _STATUS_HEADS else f"interrupted: {line}"
+
+
 def print_report(report: Any, timing: Any, quiet: bool, record: Path | None, extra_lines: list[str]) -> None:
     out, err = console(), console(stderr=True)
     if quiet:
         for w in report.view(timing).warnings:
             err.print(_warning(w), markup=False)
-        out.print(report.summary_line(timing), markup=False)
+        out.print(summary_line(report, timing), markup=False)
         for line in report.failure_lines():
             out.print(f"  {line}", markup=False)
         return
@@ -50,7 +63,9 @@ def print_report(report: Any, timing: Any, quiet: bool, record: Path | None, ext
         out.print(f"[red]failed[/red] {escape(line)}")
     for line in [*view.footer, *extra_lines]:
         out.print(line, markup=False)
-    if view.status == "ok":
+    if report.interrupted:  # the finished episodes' status is not the run's
+        out.print("[yellow]interrupted[/yellow]")
+    elif view.status == "ok":
         out.print("[green]ok[/green]")
     elif view.status == "warn":
         out.print(f"[yellow]{escape(view.status_text)}[/yellow]")
