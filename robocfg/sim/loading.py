@@ -10,6 +10,8 @@
   (``robocfg.sim.concave``; PyBullet collides with a mesh's convex hull).
 * PyBullet's C-level messages are captured; a mesh PyBullet cannot read (it then silently loads the
   link with no collision shape) or cannot find raises ConfigError naming the mesh.
+* With self collision on, the links a parallel gripper's joints move do not collide with each
+  other (:func:`filter_gripper_linkage`).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pybullet as p
 
@@ -27,9 +30,13 @@ from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf import FRAME_LINK_MASS, missing_link_mass
 from robocfg.assets.urdf_xml import read_urdf_xml
 from robocfg.checks.robot import CheckedRobot
+from robocfg.config.robot import ParallelGripperConfig
 from robocfg.errors import ConfigError
 from robocfg.sim.quiet import captured_stdout
 from robocfg.sim.visuals import split_by_material
+
+if TYPE_CHECKING:
+    from robocfg.sim.robot import RobotHandle
 
 SMALL_LINK_SIZE = 0.02  # m: cube edge used for the inertia of link_masses entries
 
@@ -157,6 +164,26 @@ def load_robot_urdf(client: int, robot: CheckedRobot, position, quat_xyzw, flags
                                              f"(the link would have no collision shape){_hint(log, fn)}")
                            for ln, fn in bad])
     return body
+
+
+def filter_gripper_linkage(client: int, robot: RobotHandle) -> None:
+    """No self-collision among the links a parallel gripper's joints move (leaders and mimic
+    followers), on the loaded ``robot`` of PyBullet client ``client``: PyBullet's convex hulls of
+    linkage parts overlap at rest and would jam."""
+    urdf = robot.checked.urdf
+    for arm in robot.arms.values():
+        g = arm.config.gripper
+        if not isinstance(g, ParallelGripperConfig):
+            continue
+        leaders = robot.checked.gripper_joints(arm.config)
+        joints = leaders + robot.checked.mimic_followers(leaders)
+        moved = set().union(*(urdf.descendants(j) for j in joints))
+        parents = {urdf.joints[j].parent for j in joints}
+        links = sorted((moved | parents) & set(robot.link_index))
+        for i, a in enumerate(links):
+            for b in links[i + 1 :]:
+                p.setCollisionFilterPair(robot.body_id, robot.body_id, robot.link(a), robot.link(b), 0,
+                                         physicsClientId=client)
 
 
 def _failure(robot: CheckedRobot, log: list[str]) -> str:

@@ -28,14 +28,13 @@ import pybullet as p
 
 from robocfg.checks.robot import CheckedRobot
 from robocfg.checks.task import CheckedTask
-from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
 from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
 from robocfg.sim.bodies import ShapeCache, spawn_body, spawn_ground, spawn_pedestal, spawn_table
 from robocfg.sim.gripper import make_gripper
-from robocfg.sim.loading import load_robot_urdf
+from robocfg.sim.loading import filter_gripper_linkage, load_robot_urdf
 from robocfg.sim.mimic import MimicGears
 from robocfg.sim.queries import SceneQueries
 from robocfg.sim.robot import RobotHandle
@@ -139,7 +138,7 @@ class World(SceneQueries):
         robot = RobotHandle(c, body, checked)
         self.bodies.setdefault(robot.name, body)
         if phys.self_collision:
-            self._filter_gripper_linkage(robot)
+            filter_gripper_linkage(c, robot)
         robot.mimic = self.mimic[body] = MimicGears(robot)
         for w in robot.mimic.skipped:
             self.warnings.append(f"robot {robot.name!r}: {w}")
@@ -164,24 +163,6 @@ class World(SceneQueries):
                 self._grippers.append(arm.gripper)
         robot.mimic.sync()
         return robot
-
-    def _filter_gripper_linkage(self, robot: RobotHandle) -> None:
-        """No self-collision among the links a parallel gripper's joints move (leaders and mimic
-        followers): PyBullet's convex hulls of linkage parts overlap at rest and would jam."""
-        urdf = robot.checked.urdf
-        for arm in robot.arms.values():
-            g = arm.config.gripper
-            if not isinstance(g, ParallelGripperConfig):
-                continue
-            leaders = robot.checked.gripper_joints(arm.config)
-            joints = leaders + robot.checked.mimic_followers(leaders)
-            moved = set().union(*(urdf.descendants(j) for j in joints))
-            parents = {urdf.joints[j].parent for j in joints}
-            links = sorted((moved | parents) & set(robot.link_index))
-            for i, a in enumerate(links):
-                for b in links[i + 1 :]:
-                    p.setCollisionFilterPair(robot.body_id, robot.body_id, robot.link(a), robot.link(b), 0,
-                                             physicsClientId=self.client)
 
     def _filter_robot_against(self, robot: RobotHandle, body: int) -> None:
         for li in robot.link_index.values():
