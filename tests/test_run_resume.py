@@ -118,3 +118,33 @@ def test_episode_records_read_back_from_json_write_the_same_bytes(report_type, n
     broken = [dict(episodes[0], success="yes")]
     with pytest.raises(RecordMismatch, match=r"episodes\[0\]\.success: expected bool"):
         records_from_json(episode_record_type(report_type), broken)
+
+
+def test_run_batch_keeps_resumed_records_in_place_when_stopped_again():
+    """Episodes 0 and 3 came from the interrupted run; a stop after episode 1 still reports 0, 1, 3
+    (in index order), and episode 1 was the only one run."""
+    from dataclasses import dataclass
+
+    from robocfg.engine import RunOptions, run_batch
+
+    @dataclass
+    class Rec:
+        index: int
+        success: bool = True
+        failed_phase: str | None = None
+        reason: str = ""
+
+    ran: list[int] = []
+
+    class Session:
+        def run(self, k):
+            ran.append(k)
+            return Rec(k)
+
+    options = RunOptions(episodes=5, resumed=(Rec(3), Rec(0)), should_stop=lambda: len(ran) >= 1)
+    records, interrupted = run_batch(Session(), options)  # type: ignore[arg-type]
+    assert interrupted and ran == [1] and [r.index for r in records] == [0, 1, 3]
+    records, interrupted = run_batch(Session(), RunOptions(episodes=5, resumed=(Rec(3), Rec(0))))
+    assert not interrupted and ran == [1, 1, 2, 4] and [r.index for r in records] == [0, 1, 2, 3, 4]
+    with pytest.raises(ValueError, match="resumed episode 7"):
+        run_batch(Session(), RunOptions(episodes=5, resumed=(Rec(7),)))
