@@ -34,7 +34,8 @@ COMMON_FLAGS = ("--robot", "--arm", "--seed", "--episodes", "--json", "--record"
 
 def test_registry_and_config_table_agree():
     kinds = registered()
-    assert set(kinds) == set(TASK_MODELS) == {"gripper", "trajectory", "follow_target", "pick_place", "grasp"}
+    assert set(kinds) == set(TASK_MODELS) == {"gripper", "trajectory", "follow_target", "pick_place", "grasp",
+                                              "pick_place_many"}
     for kind, runner in kinds.items():
         assert runner.kind == kind and runner.params is params_model(kind)
         assert dataclasses.is_dataclass(runner.report)

@@ -24,7 +24,15 @@ from robocfg.config.overrides import (
     blame_overrides,
     parse_key,
 )
-from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskBase, TaskConfig, task_union
+from robocfg.config.scene import Body
+from robocfg.config.task import (
+    TASK_MODELS,
+    PickPlaceManyTask,
+    PickPlaceTask,
+    TaskBase,
+    TaskConfig,
+    task_union,
+)
 from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError, NotFound, Problem
 from robocfg.suggest import did_you_mean
@@ -180,9 +188,16 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
             problems.extend(exc.problems)
     warnings: list[Problem] = []
     obj = config.pick_place.object if isinstance(config, PickPlaceTask) else None
-    problems += check_scene(doc, config.scene, [] if obj is None else [(("pick_place", "object"), obj)])
+    extra: list[tuple[tuple, Body]] = [] if obj is None else [(("pick_place", "object"), obj)]
+    if isinstance(config, PickPlaceManyTask):
+        extra = [(("pick_place_many", "objects", k), o) for k, o in enumerate(config.pick_place_many.objects)]
+    problems += check_scene(doc, config.scene, extra)
     if not problems:
         problems += check_task_params(doc, config, robots[0])
+    if not problems and isinstance(config, PickPlaceManyTask):
+        from robocfg.checks.clutter import check_many
+
+        problems += check_many(doc, config.scene, config.pick_place_many)
     if not problems and isinstance(config, PickPlaceTask):
         _check_pick_place(doc, config, robots[0], problems, warnings)
     if problems or (strict and warnings):

@@ -23,6 +23,7 @@ from robocfg.config.task import (
     FollowTargetTask,
     GraspTask,
     GripperTask,
+    PickPlaceManyTask,
     PickPlaceTask,
     TaskConfig,
     TrajectoryTask,
@@ -45,6 +46,10 @@ def check_task_params(doc: YamlDocument, task: TaskConfig, robot: CheckedRobot) 
     elif isinstance(task, PickPlaceTask):
         problems += _unique_against_scene(doc, task, [(("pick_place", "object"), task.pick_place.object.name)])
         problems += _timed_arm(robot, None)
+    elif isinstance(task, PickPlaceManyTask):
+        objects = task.pick_place_many.objects
+        problems += _unique_against_scene(doc, task, [(("pick_place_many", "objects", k), o.name) for k, o in enumerate(objects)])
+        problems += _timed_arm(robot, None)
     elif isinstance(task, FollowTargetTask):
         obstacles = task.follow_target.obstacles
         problems += _unique_against_scene(doc, task, [(("follow_target", "obstacles", k), o.name) for k, o in enumerate(obstacles)])
@@ -61,6 +66,9 @@ def _bodies(task: TaskConfig) -> Iterator[tuple[Loc, Body]]:
     if isinstance(task, GraspTask):
         for k, b in enumerate(task.grasp.objects):
             yield ("grasp", "objects", k), b
+    if isinstance(task, PickPlaceManyTask):
+        for k, b in enumerate(task.pick_place_many.objects):
+            yield ("pick_place_many", "objects", k), b
 
 
 def _check_meshes(doc: YamlDocument, task: TaskConfig) -> list[Problem]:

@@ -14,6 +14,7 @@ from robocfg.config.commands import (
     PickPlaceParams,
     TrajectoryParams,
 )
+from robocfg.config.multi_pick import PickPlaceManyParams
 from robocfg.config.scene import Scene, Sim
 from robocfg.config.types import Frozen, Pose, SchemaVersion
 
@@ -72,13 +73,18 @@ class PickPlaceTask(TaskBase):
     pick_place: PickPlaceParams = Field(description="Parameters of `robocfg run pick-place`.")
 
 
+class PickPlaceManyTask(TaskBase):
+    task: Literal["pick_place_many"] = Field(description="The command this file configures; selects the parameter block.")
+    pick_place_many: PickPlaceManyParams = Field(description="Parameters of `robocfg run pick-place-many`.")
+
+
 class GraspTask(TaskBase):
     task: Literal["grasp"] = Field(description="The command this file configures; selects the parameter block.")
     grasp: GraspParams = Field(default_factory=GraspParams, description="Parameters of `robocfg run grasp`.")
 
 
 TaskConfig = Annotated[
-    GripperTask | TrajectoryTask | FollowTargetTask | PickPlaceTask | GraspTask,
+    GripperTask | TrajectoryTask | FollowTargetTask | PickPlaceTask | GraspTask | PickPlaceManyTask,
     Field(discriminator="task"),
 ]
 """The built-in task kinds as a static type (what type checkers see); the validator itself is
@@ -86,7 +92,7 @@ built from ``TASK_MODELS`` by :func:`task_union`, so a kind registered later val
 
 TASK_MODELS: dict[str, type[TaskBase]] = {
     "gripper": GripperTask, "trajectory": TrajectoryTask, "follow_target": FollowTargetTask,
-    "pick_place": PickPlaceTask, "grasp": GraspTask,
+    "pick_place": PickPlaceTask, "grasp": GraspTask, "pick_place_many": PickPlaceManyTask,
 }
 """Task kind (the YAML's ``task:`` value) → its task model. The runner registry
 (``robocfg.engine.registry``) pairs each kind with its runner; a test checks the two agree.
@@ -127,7 +133,7 @@ def add_task_kind(kind: str, params: type[Frozen], description: str = "") -> typ
 
 
 def remove_task_kind(kind: str) -> None:
-    """Forget a kind declared with :func:`add_task_kind` (the built-in five stay)."""
+    """Forget a kind declared with :func:`add_task_kind` (the built-in ones stay)."""
     if kind in _BUILTIN_KINDS:
         raise ValueError(f"task kind {kind!r} is built in")
     TASK_MODELS.pop(kind, None)

@@ -30,6 +30,7 @@ _BUILTIN_MODULES = (
     "robocfg.runners.follow_target",
     "robocfg.runners.pick_place",
     "robocfg.runners.grasp",
+    "robocfg.runners.pick_place_many",
 )
 _loaded = False
 

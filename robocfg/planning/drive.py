@@ -12,7 +12,7 @@ Frames: world, 4×4, metres; joints in arm order, rad.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -31,6 +31,7 @@ if TYPE_CHECKING:
     from robocfg.sim.world import World
 
 GOAL_IK_RESTARTS = 8  # extra IK seeds tried when the nearest IK answer for a goal collides
+PARKED = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0], [0, 0, 1.0, -1000.0], [0, 0, 0, 1.0]])  # far below the scene
 
 
 @dataclass
@@ -61,12 +62,16 @@ class PlannedDrive:
     def detach(self, name: str) -> None:
         self.checker.detach(name)
 
-    def refresh_loose(self, world: World) -> None:
-        """Move the loose objects of the collision model to where they lie in ``world`` now."""
+    def refresh_loose(self, world: World, ignore: Sequence[str] = ()) -> None:
+        """Move the loose objects of the collision model to where they lie in ``world`` now; one
+        that is held (attached) or named in ``ignore`` is parked out of the way (``PARKED``)."""
         from robocfg.geometry import pose_to_matrix
 
+        held = {*self.checker.held, *ignore}
         for name in self.loose:
-            if name in world.bodies:
+            if name in held:
+                self.checker.move_shape(name, PARKED)
+            elif name in world.bodies:
                 pos, quat = world.body_pose(name)
                 self.checker.move_shape(name, pose_to_matrix(pos, quat))
 
@@ -115,10 +120,12 @@ class PlannedDrive:
 
 
 def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
-                        settings: PlannerSettings = PlannerSettings(), margin: float | None = None) -> PlannedDrive:
+                        settings: PlannerSettings = PlannerSettings(), margin: float | None = None,
+                        objects: Sequence[Body] = ()) -> PlannedDrive:
     """Planner for the arm of ``kin`` (a KinematicModel of ``robot``) among ``world``'s task scene:
-    ground, table, pedestal, obstacles, fixture parts, and the loose ``scene.objects`` (avoided
-    where they lie when each move starts; the object being picked is not among them)."""
+    ground, table, pedestal, obstacles, fixture parts, and the loose ``scene.objects`` and
+    ``objects`` (a command's own, e.g. pick_place_many's), avoided where they lie when each move
+    starts, except while held; pick_place's object being picked is not among them."""
     from robocfg.collision import robot_geometry
     from robocfg.motion.reactive.setup import body_shape, scene_shapes
     from robocfg.planning.checker import DEFAULT_MARGIN
@@ -127,7 +134,7 @@ def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
     scene = world.task.config.scene
     env, skipped = scene_shapes(scene)
     loose = []
-    for obj in scene.objects:  # neighbours in clutter: kept clear of like obstacles
+    for obj in [*scene.objects, *objects]:  # neighbours in clutter: kept clear of like obstacles
         shape = body_shape(obj)
         if shape is None:
             skipped.append(obj.name)

@@ -116,7 +116,7 @@ def planned_drive(robot, world: World, model, params: PickPlaceParams):
 
 class _StateMachine:
     def __init__(self, world, arm, tools: _Tools, params: PickPlaceParams, setup: EpisodeSetup, recorder,
-                 log: Log | None):
+                 log: Log | None, body_id: int | None = None):
         self.world, self.params, self.setup, self.recorder = world, params, setup, recorder
         self.log = log or (lambda _msg: None)
         self.arm, self.cfg, self.gripper = arm, arm.config, arm.require_gripper()
@@ -132,7 +132,7 @@ class _StateMachine:
         self.shape = tools.shape or object_shape(setup.body, world.task.path.parent)
         self.boxes = tools.boxes
         self.pad_force = tools.pad_force
-        self.obj = world.add_body(setup.body)
+        self.obj = world.add_body(setup.body) if body_id is None else body_id  # body_id: already spawned
         if self.shape.symmetry != "none":
             world.set_dynamics(self.obj, rolling_friction=ROLLING_FRICTION, spinning_friction=ROLLING_FRICTION)
         self.R0 = self._rest_on_support()
@@ -198,7 +198,7 @@ class _StateMachine:
         if self._phase is not None:
             self.close_phase(True)
         self._phase = (name, self.world.t)
-        self.mover.phase, self.mover.timeout = name, getattr(self.params.timeouts, name)
+        self.mover.phase, self.mover.timeout = name, getattr(self.params.timeouts, name, None)
         if self.recorder is not None:
             self.recorder.set_phase(name)
         n = len(self.phases) + 1

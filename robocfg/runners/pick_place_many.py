@@ -1,0 +1,278 @@
+"""``run pick-place-many``: several objects picked in turn (out of clutter or a bin) and placed into
+a bin or onto a shelf level, over seeded episodes.
+
+Episode k draws every object's position and yaw within its own region from
+``default_rng([seed, k])`` (in the order listed), spawns them all, lets them settle, then picks
+them one at a time in the listed order or, with ``order: reachability``, at each turn the object
+whose collision-free grasp needs the least joint travel. The i-th object placed goes to the i-th
+place spot (:func:`robocfg.checks.clutter.place_spots`: spaced so placed objects do not land on
+each other). Each object runs pick-place's phases (:mod:`.pick_place_many_machine`); the first
+failure ends the episode and names the object and the phase. Before simulating: the scene checks
+of :mod:`robocfg.checks.clutter` (at load) and, here, IK reach of every object's spot (nominal and
+region corners) and of every place spot used.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.config.commands import Limits, PickPlaceParams, PickPlaceRandomize, Region
+from robocfg.config.multi_pick import PickObject, PickPlaceManyParams
+from robocfg.config.robot import ParallelGripperConfig
+from robocfg.config.scene import Body
+from robocfg.engine.options import FrameRecorder
+from robocfg.engine.randomize import place_randomly
+from robocfg.engine.registry import register_task
+from robocfg.engine.session import EpisodeSession, EpisodicRunner
+from robocfg.errors import ConfigError, Problem
+from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
+from robocfg.runners.pick_place_machine import EpisodeSetup, _Tools
+from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch, ObjectMachine, Spot
+from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
+
+BLOCK = "pick_place_many"
+
+
+def as_body(o: PickObject) -> Body:
+    """The object without its region."""
+    return Body(**{k: getattr(o, k) for k in Body.model_fields})
+
+
+def object_params(params: PickPlaceManyParams, body: Body, place_xy: np.ndarray) -> PickPlaceParams:
+    """Pick-place's parameters for one object going to ``place_xy`` (the shared settings)."""
+    return PickPlaceParams(
+        object=body, place_position=[float(place_xy[0]), float(place_xy[1]), 0.0],
+        randomize=PickPlaceRandomize(object=Region(), place=Region()), above_height=params.above_height,
+        lift_height=params.lift_height, grasp_depth=params.grasp_depth, position_tolerance=params.position_tolerance,
+        orientation_tolerance=params.orientation_tolerance, timeouts=params.timeouts, motion=params.motion,
+        speed_scale=params.speed_scale, grip_force=params.grip_force, success_tolerance=params.success_tolerance,
+        max_tilt_deg=params.max_tilt_deg)
+
+
+def spots_for(task, params: PickPlaceManyParams) -> list[Spot]:
+    """The place spots the objects take, in order (one per object)."""
+    from robocfg.checks.clutter import footprint_radius, place_fixture, place_spots
+    from robocfg.config.fixtures import ShelfFixture
+
+    scene = task.config.scene
+    radius = max(footprint_radius(o, task.path.parent) for o in params.objects)
+    spots = place_spots(scene, params.place, radius)
+    f = place_fixture(scene, params.place)
+    to_front = params.place.depth * (f.size[0] - f.board) if isinstance(f, ShelfFixture) else 0.0
+    return [Spot(float(p[2]), spots.front, to_front, spots.ceiling) for p in spots.points[: len(params.objects)]]
+
+
+def spot_points(task, params: PickPlaceManyParams) -> np.ndarray:
+    from robocfg.checks.clutter import footprint_radius, place_spots
+
+    radius = max(footprint_radius(o, task.path.parent) for o in params.objects)
+    return place_spots(task.config.scene, params.place, radius).points[: len(params.objects)]
+
+
+class ManySession(EpisodeSession[ManyEpisode]):
+    """The world, kinematic model, planner, grasp filter and place spots every episode shares."""
+
+    def prepare(self) -> None:
+        from robocfg.assets.object_shape import object_shape
+        from robocfg.grasp.gripper_model import measure_gripper
+        from robocfg.kinematics.model import KinematicModel
+        from robocfg.motion.limits import limits_from_robot
+        from robocfg.planning.drive import build_planned_drive
+
+        robot = self.task.robots[0]
+        self.arm_cfg = robot.config.arm(self.options.arm)
+        self.params: PickPlaceManyParams = self.task.config.pick_place_many  # type: ignore[union-attr]
+        self.handle = self.world.robot.arm(self.arm_cfg.name)
+        self.bodies = [as_body(o) for o in self.params.objects]
+        self.shapes = [object_shape(b, self.task.path.parent) for b in self.bodies]
+        self.spots = spots_for(self.task, self.params)
+        self.spot_xy = spot_points(self.task, self.params)[:, :2]
+        model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
+        bound_ik_by_iterations(model)
+        scale = self.params.speed_scale
+        limits = limits_from_robot(robot, self.handle.joints, Limits(velocity_scale=scale, acceleration_scale=scale))
+        boxes = measure_gripper(self.world.robot, self.handle) if isinstance(self.arm_cfg.gripper, ParallelGripperConfig) else None
+        planned = None
+        if self.params.motion == "planned":
+            planned = build_planned_drive(robot, self.world, model, objects=self.bodies)
+        self.tools = _Tools(model, limits, None, planned, boxes=boxes)
+        self.clutter = build_planned_drive(robot, self.world, model, margin=self.params.clutter_margin, objects=self.bodies)
+        scene = self.task.config.scene
+        self.parts = [b.name for b in [*scene.obstacles, *scene.fixture_parts()]]
+
+    def episode(self, k: int, recorder: FrameRecorder | None) -> ManyEpisode:
+        rng = self.rng(k)
+        placed = [place_randomly(b, o.region, rng) for b, o in zip(self.bodies, self.params.objects, strict=True)]
+        ids = [self.spawn(pl.body) for pl in placed]
+        current: list[ObjectMachine] = []
+        watch = ContactWatch(self.world, self.parts, lambda: current[0].mover.phase if current else "setup")
+        clutter = ClutterFilter(self.clutter)
+        machines: dict[str, ObjectMachine] = {}
+        for i, (pl, bid) in enumerate(zip(placed, ids, strict=True)):
+            body = pl.body
+            yaw = math.radians((self.bodies[i].euler_deg or [0, 0, 0])[2]) + pl.yaw
+            setup = EpisodeSetup(k, self.seed + k, body, yaw, self.spot_xy[0])
+            tools = dataclasses.replace(self.tools, shape=self.shapes[i])
+            machines[body.name] = ObjectMachine(
+                self.world, self.handle, tools, object_params(self.params, body, self.spot_xy[0]), setup, recorder,
+                self.log_for(k), body_id=bid, clutter=clutter, spot=self.spots[0], on_step=watch.on_step,
+                place_clearance=self.params.place_clearance)
+        first = next(iter(machines.values()))
+        first.gripper.open()
+        first.mover.settle(0.2)
+        starts = {n: m.world.body_pose(m.obj) for n, m in machines.items()}
+        remaining, order = list(machines), list[str]()
+        failure: tuple[str, str, str] | None = None
+        while remaining and failure is None:
+            turn = len(order)
+            for n in remaining:
+                machines[n].assign(self.spot_xy[turn], self.spots[turn])
+            name = self._next(machines, remaining)
+            m = machines[name]
+            current[:] = [m]
+            order.append(name)
+            remaining.remove(name)
+            try:
+                m.run()
+            except MoveFailed as exc:
+                m.close_phase(False, exc.reason)
+                failure = (name, exc.phase, exc.reason)
+        records = [self._record(machines[b.name], b.name in order, starts[b.name], failure) for b in self.bodies]
+        return ManyEpisode(
+            index=k, seed=self.seed + k, success=failure is None, failed_phase=failure[1] if failure else None,
+            failed_object=failure[0] if failure else None,
+            reason=f"{failure[0]}: {failure[2]}" if failure else f"{len(order)} objects placed",
+            placed=sum(r.success for r in records), order=order, robot_fixture_contacts=watch.count,
+            first_contact=watch.first, sim_time=round(self.world.t, 6), steps=self.world.steps, objects=records)
+
+    def _next(self, machines: dict[str, ObjectMachine], remaining: list[str]) -> str:
+        """The next object: the first listed, or (reachability) the one whose collision-free grasp
+        needs the least joint travel (the first listed when none has one: it fails naming why)."""
+        if self.params.order == "listed":
+            return remaining[0]
+        costs = []
+        for n in remaining:
+            try:
+                costs.append(machines[n].plan_grasp())
+            except MoveFailed:
+                costs.append(math.inf)
+        best = int(np.argmin(costs))
+        return remaining[best] if costs[best] < math.inf else remaining[0]
+
+    def _record(self, m: ObjectMachine, attempted: bool, start, failure: tuple[str, str, str] | None) -> ObjectRecord:
+        pos, quat = self.world.body_pose(m.obj)
+        from robocfg.geometry import quat_to_matrix
+
+        mine = failure is not None and failure[0] == m.setup.body.name
+        ok = attempted and not mine
+        tilt = m.shape.tilt_deg(quat_to_matrix(start[1]), quat_to_matrix(quat))
+        return ObjectRecord(
+            name=m.setup.body.name, attempted=attempted, success=ok, failed_phase=failure[1] if mine and failure else None,
+            reason=(failure[2] if mine and failure else "placed" if ok else "not attempted: an earlier object failed"),
+            start=[round(float(v), 6) for v in start[0]], start_yaw_deg=round(math.degrees(m.setup.yaw), 4),
+            place_target=[round(float(v), 6) for v in m.setup.place_xy] if attempted else [],
+            final=[round(float(v), 6) for v in pos],
+            place_error=round(float(np.linalg.norm(pos[:2] - m.setup.place_xy)), 6) if attempted else None,
+            tilt_deg=round(tilt, 4), grasp_candidates=m.candidates, grasps_in_collision=m.in_collision,
+            phases=m.phases)
+
+    def report(self, records: list[ManyEpisode], interrupted: bool) -> ManyReport:
+        warnings = [w.format() for w in self.task.warnings]
+        planned = self.tools.planned
+        unseen = planned.skipped if planned is not None else []
+        warnings += [f"body {name!r} is a mesh: the planner does not avoid it" for name in unseen]
+        warnings += list(self.reach_warnings)
+        return ManyReport(task=str(self.task.path), robot=self.task.robots[0].config.name, arm=self.arm_cfg.name,
+                          seed=self.seed, summary=summarise(records), episodes=records, warnings=warnings,
+                          interrupted=interrupted)
+
+    reach_warnings: tuple[str, ...] = ()
+
+
+@register_task
+class PickPlaceManyRunner(EpisodicRunner):
+    kind = "pick_place_many"
+    params = PickPlaceManyParams
+    report = ManyReport
+    verb = "cleared"
+    summary = "Pick objects in turn into a bin or onto a shelf."
+    description = (
+        "Each episode randomises every object in its own region, then picks them one at a time (listed order, or "
+        "by reachability) with grasps filtered for collisions of the whole arm and gripper with the neighbours and "
+        "fixtures, and places them on spots spaced so they do not land on each other. Exit 0 when the share of "
+        "episodes with every object placed reaches --min-success; failures name the object and the phase.")
+
+    def check(self) -> None:
+        super().check()
+        self._reach = reach_many(self.task, self.options.arm)
+        errors = [p for p in self._reach if p.severity == "error"]
+        if errors:
+            raise ConfigError(errors)
+
+    def open_session(self) -> ManySession:
+        session = ManySession(self.task, self.options)
+        session.reach_warnings = tuple(p.format() for p in getattr(self, "_reach", []) if p.severity == "warning")
+        return session
+
+
+@dataclass(frozen=True)
+class _Point:
+    what: str
+    phase: str
+    point: np.ndarray
+    nominal: bool
+    loc: tuple
+
+
+def reach_many(task, arm: str | None = None) -> list[Problem]:
+    """IK reach, tool pointing down, of every object's grasp and pre-grasp points (nominal: error;
+    region corners: warning) and of every place spot used with the point above it (error)."""
+    from itertools import product
+
+    from robocfg.assets.object_shape import object_shape
+    from robocfg.geometry import pose_matrix, quat_to_matrix
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.reach import _best_residual, support_height
+
+    params: PickPlaceManyParams = task.config.pick_place_many
+    robot = task.robots[0]
+    arm_cfg = robot.config.arm(arm)
+    model = KinematicModel.from_robot(robot, arm=arm_cfg.name, base_pose=pose_matrix(task.config.robots[0]))
+    bound_ik_by_iterations(model)
+    home = np.asarray(arm_cfg.home, float)
+    scene, base = task.config.scene, task.path.parent
+    spots = spot_points(task, params)
+    rise = params.place_clearance if spots_for(task, params)[0].ceiling is not None else params.lift_height
+    points: list[_Point] = []
+    for k, o in enumerate(params.objects):
+        shape = object_shape(o, base)
+        up = shape.below_origin(quat_to_matrix(o.quaternion_xyzw()))
+        loc = (BLOCK, "objects", k, "position")
+        rx, ry = o.region.xy_range
+        corners = [(True, (0.0, 0.0)), *((False, c) for c in product((-1.0, 1.0), repeat=2) if rx or ry)]
+        for nominal, (sx, sy) in corners:
+            x, y = o.position[0] + sx * rx, o.position[1] + sy * ry
+            z = support_height(scene, x, y, base) + up
+            points.append(_Point(f"object {o.name!r}: the pose above it", "pre_grasp",
+                                 np.array([x, y, z + params.above_height]), nominal, loc))
+            points.append(_Point(f"object {o.name!r}: its grasp pose", "approach", np.array([x, y, z]), nominal, loc))
+        sp = spots[k]
+        z = float(sp[2]) + up
+        ploc = (BLOCK, "place", "fixture")
+        points.append(_Point(f"place spot {k + 1} ([{sp[0]:.3f}, {sp[1]:.3f}] m)", "lower", np.array([sp[0], sp[1], z]), True, ploc))
+        points.append(_Point(f"the pose above place spot {k + 1}", "transport", np.array([sp[0], sp[1], z + rise]), True, ploc))
+    out: list[Problem] = []
+    for pt in points:
+        residual = _best_residual(model, arm_cfg, home, pt.point)
+        if residual is None:
+            continue
+        x, y, z = pt.point
+        where = "nominal point" if pt.nominal else "a corner of its randomisation region"
+        out.append(task.doc.problem(pt.loc, f"{pt.phase}: {pt.what} is out of the arm's reach ({where}, TCP at "
+                                            f"[{x:.3f}, {y:.3f}, {z:.3f}] m, IK residual {residual * 1000:.0f} mm)",
+                                    "error" if pt.nominal else "warning"))
+    return out

@@ -1,0 +1,248 @@
+"""One object's pick and place inside a ``pick_place_many`` episode, and what watches the episode.
+
+:class:`ObjectMachine` is pick-place's state machine (:mod:`robocfg.runners.pick_place_machine`)
+for an object already lying in a scene full of others, with two changes:
+
+* **grasps in clutter**: every candidate grasp (from the object's geometry) is kept only if the
+  whole arm and gripper, at the IK configurations of the grasp and of the pre-grasp above it, keep
+  ``clutter_margin`` from the neighbouring objects, the fixtures and the obstacles
+  (:class:`ClutterFilter`, pinocchio + coal on the robot's collision model; the object itself is
+  left out). Among the kept ones the choice is pick-place's (least joint travel);
+* **the place spot**: a bin spot is approached from ``lift_height`` above and left straight up; a
+  shelf spot is entered ``place_clearance`` above its board (the planner finds the way in through
+  the open front), lowered onto, and left by lifting back to that height and withdrawing out of
+  the front (phase ``withdraw``), planned collision-free.
+
+:class:`ContactWatch` counts robot–fixture contacts in the simulation (every ``SETTLE_POLL``
+physics steps), the figure that must stay 0. Frames: world, 4×4, metres.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robocfg.geometry import quat_to_matrix, rotation_angle
+from robocfg.grasp.object_grasp import LyingObject
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
+from robocfg.motion.moves import MoveFailed
+from robocfg.runners.pick_place_machine import (
+    RELEASE_CLEARANCE,
+    SETTLE_POLL,
+    _shifted,
+    _StateMachine,
+)
+
+if TYPE_CHECKING:
+    from robocfg.planning.drive import PlannedDrive
+    from robocfg.sim.world import World
+
+WITHDRAW_BEYOND = 0.12  # m: how far past a shelf's front edge the TCP withdraws
+
+
+@dataclass(frozen=True)
+class Spot:
+    """Where one object goes: the support's top face under it (``z``, m), the unit vector out of
+    the target through its open side (zero for a bin: open upwards), the distance (m) from the spot
+    to that open side, and the underside of the board above (m; None for a bin)."""
+
+    z: float
+    front: np.ndarray
+    to_front: float
+    ceiling: float | None
+
+
+@dataclass
+class ContactWatch:
+    """Counts polls (every ``SETTLE_POLL`` physics steps) at which the robot touches a fixture
+    part or an obstacle, and names the first such contact (phase, link, part)."""
+
+    world: World
+    parts: list[str]
+    phase: Callable[[], str]
+    count: int = 0
+    first: str | None = None
+    _steps: int = 0
+
+    def on_step(self) -> None:
+        self._steps += 1
+        if self._steps % SETTLE_POLL:
+            return
+        robot = self.world.robot
+        for part in self.parts:
+            pts = self.world.contact_points(robot.body_id, part)
+            if pts:
+                self.count += 1
+                if self.first is None:
+                    self.first = f"{self.phase()}: {robot.link_name(pts[0].link_a)} touched {part}"
+                return
+
+
+@dataclass
+class ClutterFilter:
+    """Collision test of candidate grasps: ``drive`` is a planner's collision model of the scene
+    (objects included) built with the clutter margin; ``rejected`` lists, per object, what the
+    rejected candidates hit (first pair), for the failure message."""
+
+    drive: PlannedDrive
+    rejected: list[str] = field(default_factory=list)
+
+    def free(self, world: World, target: str, q_pre: np.ndarray, q_grasp: np.ndarray) -> bool:
+        """True if the arm and gripper at ``q_pre`` and ``q_grasp`` keep the margin from everything
+        but ``target`` (the object being grasped)."""
+        checker = self.drive.checker
+        for q in (q_pre, q_grasp):
+            if not checker.is_valid(q):
+                hit = checker.contacts(q)
+                self.rejected.append(hit[0].describe() if hit else "a pair within the margin")
+                return False
+        return True
+
+
+class ObjectMachine(_StateMachine):
+    """Pick-place of one object among others (see the module doc). ``body_id``: the object,
+    already spawned; ``clutter``: the grasp filter (None: no filter); ``spot``: the place spot."""
+
+    def __init__(self, world, arm, tools, params, setup, recorder, log, *, body_id: int, clutter: ClutterFilter | None,
+                 spot: Spot, on_step: Callable[[], None] | None = None, place_clearance: float = 0.03):
+        self._extra_step = on_step
+        super().__init__(world, arm, tools, params, setup, recorder, log, body_id=body_id)
+        self.clutter, self.spot, self.place_clearance = clutter, spot, place_clearance
+        self.grasp: Grasp | None = None
+        self.cost = math.inf  # joint travel (rad) of the chosen grasp
+        self.candidates = 0
+        self.rejected: list[str] = []  # what each candidate dropped for a collision hit (first pair)
+
+    @property
+    def in_collision(self) -> int:
+        return len(self.rejected)
+
+    def assign(self, place_xy: np.ndarray, spot: Spot) -> None:
+        """Send the object to ``place_xy`` (x, y in m) on ``spot`` (forgets a chosen grasp)."""
+        self.setup = dataclasses.replace(self.setup, place_xy=np.asarray(place_xy, float))
+        self.spot, self.grasp = spot, None
+
+    # ---- grasp choice ------------------------------------------------------------------------
+    def plan_grasp(self) -> float:
+        """Choose the grasp (clutter-filtered, least joint travel); return its travel (rad),
+        inf when no candidate is reachable and collision-free."""
+        pos, quat = self.world.body_pose(self.obj)
+        self.R0 = quat_to_matrix(quat)
+        lying = LyingObject(self.shape, pos, self.R0, self._support_height(pos[:2]))
+        self.support_z = lying.support_z
+        groups = self._grasp_groups(lying)
+        if self.clutter is not None:
+            self.clutter.drive.refresh_loose(self.world, ignore=(self.setup.body.name,))
+            self.clutter.rejected.clear()
+        self.candidates = sum(len(g) for g in groups)
+        R_now = self.arm.ee_pose()[:3, :3]
+        q0 = self.arm.joint_positions()
+        self.grasp, self.cost = None, math.inf
+        for group in groups:
+            cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+            scored = [(self._travel(g, q0), g) for g in cands]
+            scored = [(c, g) for c, g in scored if c < math.inf]
+            if scored:
+                self.cost, self.grasp = min(scored, key=lambda t: t[0])
+                break
+        self.rejected = list(self.clutter.rejected) if self.clutter is not None else []
+        if self.grasp is None and not groups:
+            raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
+        return self.cost
+
+    def _travel(self, g: Grasp, q0: np.ndarray) -> float:
+        """Largest joint change (rad) to the pre-grasp and on to the pose above the place point;
+        inf when IK fails there or the grasp or pre-grasp configuration collides."""
+        mover = self.mover
+        T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
+        pre = self.model.ik(T_pre, seed_q=q0, frame="ee", time_budget=mover.ik_budget)
+        if not pre.converged:
+            return math.inf
+        if self.clutter is not None:
+            at = self.model.ik(ee_pose_from_grasp(g, self.cfg), seed_q=pre.q, frame="ee", time_budget=mover.ik_budget)
+            if not at.converged or not self.clutter.free(self.world, self.setup.body.name, pre.q, at.q):
+                return math.inf
+        shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
+        above = self.model.ik(_shifted(T_pre, shift), seed_q=pre.q, frame="ee", time_budget=mover.ik_budget)
+        if not above.converged:
+            return math.inf
+        return max(float(np.max(np.abs(pre.q - q0))), float(np.max(np.abs(above.q - pre.q))))
+
+    def grasp_failure(self) -> str:
+        """Why no grasp was chosen: what the candidates collided with, or that IK missed them."""
+        if self.rejected:
+            common = max(sorted(set(self.rejected)), key=self.rejected.count)
+            return (f"no collision-free grasp: {len(self.rejected)} of {self.candidates} candidates put the "
+                    f"arm or gripper within the clutter margin (e.g. {common})")
+        return f"no reachable grasp among {self.candidates} candidates"
+
+    # ---- phases ------------------------------------------------------------------------------
+    def run(self) -> None:
+        p = self.params
+        if self.grasp is None:
+            self.plan_grasp()
+        if self.grasp is None:
+            raise MoveFailed("grasp_choice", self.grasp_failure())
+        grasp = self.grasp
+        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
+        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
+        self.begin("pre_grasp", "move above the object")
+        self._free_move(T_pre)
+        self.begin("approach", "down to grasp height")
+        self.mover.move(T_grasp, straight=True)
+        self.begin("grasp", "close the gripper")
+        self.mover.close_until_held(self.obj, p.timeouts.grasp)
+        self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
+        z0 = self.world.body_pose(self.obj)[0][2]
+        T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
+        self.mover.move(T_lift, straight=True)
+        self._verify_lift(z0)
+        offset = self.arm.ee_pose()[:3, 3] - self.world.body_pose(self.obj)[0]
+        place_z = self.spot.z + self.shape.below_origin(self.R0) + RELEASE_CLEARANCE
+        T_place = T_lift.copy()
+        T_place[:3, 3] = np.array([*self.setup.place_xy, place_z]) + offset
+        shelf = self.spot.ceiling is not None
+        rise = self.place_clearance if shelf else p.lift_height
+        T_above = _shifted(T_place, [0, 0, rise])
+        if not shelf:
+            T_above[2, 3] = max(T_lift[2, 3], T_above[2, 3])
+        if self.planned is not None:
+            self._attach_held()
+        self.begin("transport", "carry above the place spot")
+        self._free_move(T_above, check=self._dropped)
+        self.begin("lower", "lower onto the support")
+        self.mover.move(T_place, straight=True, check=self._dropped)
+        self.begin("release", "open the gripper")
+        self._release()
+        if self.planned is not None:
+            self.planned.detach(self.setup.body.name)
+        if shelf:
+            self.begin("retract", "lift clear of the object")
+            self.mover.move(_shifted(T_place, [0, 0, rise]), straight=True)
+            self.begin("withdraw", "out of the shelf's front")
+            out = self.spot.front * (self.spot.to_front + WITHDRAW_BEYOND)
+            self._free_move(_shifted(T_place, [out[0], out[1], rise]))
+        else:
+            self.begin("retract", "move up and away")
+            self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
+        self.close_phase(True)
+        self.mover.settle(0.3)
+        self._check_placed()
+
+    # ---- world helpers -----------------------------------------------------------------------
+    def _support_height(self, xy: np.ndarray) -> float:
+        """The place spot's board or floor (known exactly; a ray from above would find a shelf's
+        top board), elsewhere the first surface below ``xy``."""
+        if np.allclose(np.asarray(xy, float)[:2], self.setup.place_xy, atol=1e-9):
+            return self.spot.z
+        return super()._support_height(xy)
+
+    def _on_step(self) -> None:
+        super()._on_step()
+        if self._extra_step is not None:
+            self._extra_step()
