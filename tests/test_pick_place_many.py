@@ -102,3 +102,71 @@ def test_bin_to_bin_places_all_five_without_touching_a_fixture(bin_to_bin):
     finals = np.array([o.final[:2] for o in ep.objects])
     gaps = np.linalg.norm(finals[:, None] - finals[None], axis=2) + np.eye(5)
     assert gaps.min() > 0.07  # on separate spots
+
+
+def test_shelf_placing_puts_each_object_on_the_level_and_withdraws_through_the_front():
+    task = load_task(catalog.find("tasks", "pick_place_shelf"))
+    (ep,) = PickPlaceManyRunner(task, RunOptions(seed=0, episodes=1)).run().report.episodes
+    assert ep.success, ep.reason
+    assert ep.robot_fixture_contacts == 0, ep.first_contact
+    for o, half in zip(ep.objects, (0.025, 0.025, 0.02), strict=True):
+        # on level 1 (top face 0.2 m), inside the shelf (x 0.49..0.73, y 0.02..0.58 between the sides)
+        assert o.final[2] == pytest.approx(0.2 + half, abs=0.003) and o.tilt_deg < 5, o
+        assert 0.49 < o.final[0] < 0.73 and 0.02 < o.final[1] < 0.58
+        assert [p.name for p in o.phases][-2:] == ["retract", "withdraw"]
+
+
+def test_clear_table_picks_by_reachability_with_grasps_clear_of_the_neighbours():
+    task = load_task(catalog.find("tasks", "clear_table"))
+    (ep,) = PickPlaceManyRunner(task, RunOptions(seed=0, episodes=1)).run().report.episodes
+    assert ep.success, ep.reason
+    assert ep.placed == 5 and sorted(ep.order) == sorted(o.name for o in task.config.pick_place_many.objects)
+    assert ep.order != [o.name for o in task.config.pick_place_many.objects]  # not simply the listed order
+    assert sum(o.grasps_in_collision for o in ep.objects) > 0  # the close neighbours did rule grasps out
+    assert ep.robot_fixture_contacts == 0, ep.first_contact
+
+
+def test_grasps_the_filter_drops_touch_a_neighbour_in_pybullet_too(monkeypatch):
+    """The clutter filter (pinocchio + coal hulls) against PyBullet's own collision detection: each
+    configuration it rejects or accepts is rebuilt in a second PyBullet world (same object poses,
+    arm at the configuration, fingers open) and measured there."""
+    from robocfg.runners import pick_place_many_machine as machine
+    from robocfg.sim.world import World
+
+    task = load_task(catalog.find("tasks", "clear_table"))
+    twin = World(task)
+    arm = twin.robot.arm()
+    arm.require_gripper().open()
+    twin.step(120)  # fingers open
+    seen: list[tuple[bool, float]] = []
+    free = machine.ClutterFilter.free
+
+    def spy(self, world, target, q_pre, q_grasp):
+        ok = free(self, world, target, q_pre, q_grasp)
+        names = [b.name for b in task.config.pick_place_many.objects if b.name != target]
+        for n in names:
+            pos, quat = world.body_pose(n)
+            if n not in twin.bodies:
+                twin.add_body(task.config.pick_place_many.objects[[b.name for b in task.config.pick_place_many.objects].index(n)])
+            twin.set_body_pose(n, pos, quat)
+        if target in twin.bodies:
+            twin.remove_body(target)
+        others = names + [b for b in twin.bodies if "/" in b]
+        gaps = []
+        for q in (q_pre, q_grasp):
+            twin.robot.reset_joints(arm.joints, q)
+            gaps += [c.distance for b in others for c in twin.closest_points(twin.robot.body_id, b, 0.05)]
+        seen.append((ok, min(gaps, default=0.05)))
+        return ok
+
+    monkeypatch.setattr(machine.ClutterFilter, "free", spy)
+    try:
+        PickPlaceManyRunner(task, RunOptions(seed=0, episodes=1)).run()
+    finally:
+        twin.close()
+    rejected = [d for ok, d in seen if not ok]
+    accepted = [d for ok, d in seen if ok]
+    margin = task.config.pick_place_many.clutter_margin
+    assert rejected and accepted
+    assert all(d < margin + 0.004 for d in rejected), rejected  # PyBullet finds them close (hulls: ±4 mm)
+    assert all(d > 0.001 for d in accepted), min(accepted)  # and the kept ones clear

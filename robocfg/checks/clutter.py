@@ -61,7 +61,8 @@ def place_fixture(scene: Scene, place: PlaceInto) -> BinFixture | ShelfFixture |
 def place_spots(scene: Scene, place: PlaceInto, radius: float) -> PlaceSpots:
     """Every spot of ``place`` (a bin's floor or a shelf board) where an object of footprint
     ``radius`` (m) keeps ``place.gap`` from the walls and from objects on the neighbouring spots:
-    a grid of pitch 2·radius + gap, centred; a shelf board gets one row at ``place.depth``."""
+    a grid of pitch 2·radius + gap, centred; a shelf board gets one row at ``place.depth``. The
+    spots come middle first (by distance from the grid's centre; ties in grid order)."""
     from robocfg.geometry import pose_matrix
 
     f = place_fixture(scene, place)
@@ -83,6 +84,8 @@ def place_spots(scene: Scene, place: PlaceInto, radius: float) -> PlaceSpots:
         front = np.array([-1.0, 0.0, 0.0])
     T = pose_matrix(f)
     local = np.array([[a, b, h, 1.0] for a in xs for b in ys]).reshape(-1, 4)
+    # middle spots first (stable): away from the walls and sides, where an arm has the most room
+    local = local[np.argsort(np.hypot(local[:, 0] - (xs.mean() if len(xs) else 0.0), local[:, 1]), kind="stable")]
     pts = (T @ local.T).T[:, :3]
     return PlaceSpots(pts, T[:3, :3] @ front, None if ceiling is None else float(T[2, 3] + ceiling))
 

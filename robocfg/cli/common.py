@@ -81,7 +81,8 @@ def console(stderr: bool = False):
     stderr = stderr or _stdout_taken  # ``--json -`` owns standard output
     stream = sys.stderr if stderr else sys.stdout
     width = None if stream.isatty() else 160
-    return Console(stderr=stderr, highlight=False, soft_wrap=True, width=width)
+    # emoji=False: rich would print "FILE:100:7" as "FILE💯7" (":100:" is an emoji code)
+    return Console(stderr=stderr, highlight=False, soft_wrap=True, width=width, emoji=False)
 
 
 def write_json(path: Path | None, payload: Any) -> None:

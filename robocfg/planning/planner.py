@@ -126,11 +126,15 @@ class JointPlanner:
     def search_box(self, qs: np.ndarray, qg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The joint box RRT samples: the limits, narrowed for joints that can turn more than a full
         revolution (e.g. ±2π wrists) to within π beyond the start and goal values, since farther
-        angles repeat arm poses already inside that window and only lengthen the path."""
+        angles repeat arm poses already inside that window and only lengthen the path; widened to
+        hold the start and the goal where they lie past a limit."""
         lo = np.maximum(self.lower, np.minimum(qs, qg) - np.pi)
         hi = np.minimum(self.upper, np.maximum(qs, qg) + np.pi)
         wide = (self.upper - self.lower) > 2 * np.pi + 1e-9
-        return np.where(wide, lo, self.lower), np.where(wide, hi, self.upper)
+        lo, hi = np.where(wide, lo, self.lower), np.where(wide, hi, self.upper)
+        # a simulated joint can sit a hair past its limit (the drive overshoots): OMPL rejects a
+        # start outside the box without a single check, so the box always holds both ends
+        return np.minimum(lo, np.minimum(qs, qg)), np.maximum(hi, np.maximum(qs, qg))
 
     def timed(self, path: PlannedPath, limits: JointLimits) -> Plan:
         """toppra timing of ``path`` (within ``limits``), checked sample by sample; stops at every

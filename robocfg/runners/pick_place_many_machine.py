@@ -42,7 +42,9 @@ if TYPE_CHECKING:
     from robocfg.planning.drive import PlannedDrive
     from robocfg.sim.world import World
 
+CARRIED_OFF = 0.01  # m: a released object that rises this much during the retract went with the fingers
 WITHDRAW_BEYOND = 0.12  # m: how far past a shelf's front edge the TCP withdraws
+FINGER_CLEARANCE = 0.025  # m: fingertips above a placed object's top before withdrawing: the planner's 1 cm margin, the 5 mm position tolerance, 1 cm spare
 
 
 @dataclass(frozen=True)
@@ -221,18 +223,37 @@ class ObjectMachine(_StateMachine):
         self._release()
         if self.planned is not None:
             self.planned.detach(self.setup.body.name)
+        z_released = float(self.world.body_pose(self.obj)[0][2])
         if shelf:
-            self.begin("retract", "lift clear of the object")
-            self.mover.move(_shifted(T_place, [0, 0, rise]), straight=True)
+            up = max(rise, self._fingers_clear_height())
+            self.begin("retract", "lift the fingers clear of the object")
+            self.mover.move(_shifted(T_place, [0, 0, up]), straight=True, check=lambda: self._carried_off(z_released))
             self.begin("withdraw", "out of the shelf's front")
             out = self.spot.front * (self.spot.to_front + WITHDRAW_BEYOND)
-            self._free_move(_shifted(T_place, [out[0], out[1], rise]))
+            self._free_move(_shifted(T_place, [out[0], out[1], up]))
         else:
             self.begin("retract", "move up and away")
-            self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
+            self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True,
+                            check=lambda: self._carried_off(z_released))
         self.close_phase(True)
         self.mover.settle(0.3)
         self._check_placed()
+
+    def _carried_off(self, z_released: float) -> str | None:
+        """Why the retract failed if the released object rose with the fingers (stuck to one)."""
+        rise = float(self.world.body_pose(self.obj)[0][2]) - z_released
+        return f"the released object rose {rise * 100:.1f} cm with the fingers" if rise > CARRIED_OFF else None
+
+    def _fingers_clear_height(self) -> float:
+        """How far (m) the TCP must rise from where it let go for the fingertips (at any opening,
+        from the measured gripper boxes) to be ``FINGER_CLEARANCE`` above the object's top."""
+        if self.boxes is None:
+            return 0.0
+        sweep = self.boxes.closing_sweep(None)
+        tip = float(sweep.hi[sweep.finger, 0].max())  # m past the TCP along the approach (down)
+        pos, quat = self.world.body_pose(self.obj)
+        top = float(pos[2] + self.shape.posed(quat_to_matrix(quat))[:, 2].max())
+        return top - (float(self.arm.tcp_pose()[2, 3]) - tip) + FINGER_CLEARANCE
 
     # ---- world helpers -----------------------------------------------------------------------
     def _support_height(self, xy: np.ndarray) -> float:
