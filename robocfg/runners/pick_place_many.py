@@ -78,6 +78,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
 
     def prepare(self) -> None:
         from robocfg.assets.object_shape import object_shape
+        from robocfg.checks.grip_force import pad_force
         from robocfg.grasp.gripper_model import measure_gripper
         from robocfg.kinematics.model import KinematicModel
         from robocfg.motion.limits import limits_from_robot
@@ -99,7 +100,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
         planned = None
         if self.params.motion == "planned":
             planned = build_planned_drive(robot, self.world, model, objects=self.bodies)
-        self.tools = _Tools(model, limits, None, planned, boxes=boxes)
+        self.tools = _Tools(model, limits, None, planned, boxes=boxes, pad_force=pad_force(robot, self.arm_cfg))
         self.clutter = build_planned_drive(robot, self.world, model, margin=self.params.clutter_margin, objects=self.bodies)
         scene = self.task.config.scene
         self.parts = [b.name for b in [*scene.obstacles, *scene.fixture_parts()]]
@@ -107,7 +108,9 @@ class ManySession(EpisodeSession[ManyEpisode]):
     def episode(self, k: int, recorder: FrameRecorder | None) -> ManyEpisode:
         rng = self.rng(k)
         placed = [place_randomly(b, o.region, rng) for b, o in zip(self.bodies, self.params.objects, strict=True)]
-        ids = [self.spawn(pl.body) for pl in placed]
+        ids = [self.world.add_body(pl.body) for pl in placed]
+        for pl in reversed(placed):  # removed last-spawned first (Bullet's arrays shrink from the end)
+            self.remove_after_episode(pl.body.name)
         current: list[ObjectMachine] = []
         watch = ContactWatch(self.world, self.parts, lambda: current[0].mover.phase if current else "setup")
         clutter = ClutterFilter(self.clutter)

@@ -199,13 +199,16 @@ class ObjectMachine(_StateMachine):
         self.mover.move(T_grasp, straight=True)
         self.begin("grasp", "close the gripper")
         self.mover.close_until_held(self.obj, p.timeouts.grasp)
+        self._limit_acceleration()
         self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
         z0 = self.world.body_pose(self.obj)[0][2]
         T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
         self.mover.move(T_lift, straight=True)
         self._verify_lift(z0)
-        offset = self.arm.ee_pose()[:3, 3] - self.world.body_pose(self.obj)[0]
-        place_z = self.spot.z + self.shape.below_origin(self.R0) + RELEASE_CLEARANCE
+        obj_now, quat_now = self.world.body_pose(self.obj)
+        offset = self.arm.ee_pose()[:3, 3] - obj_now
+        # its lowest point as it now hangs in the hand (it may have turned a little in the grasp)
+        place_z = self.spot.z + self.shape.below_origin(quat_to_matrix(quat_now)) + RELEASE_CLEARANCE
         T_place = T_lift.copy()
         T_place[:3, 3] = np.array([*self.setup.place_xy, place_z]) + offset
         shelf = self.spot.ceiling is not None
@@ -220,6 +223,7 @@ class ObjectMachine(_StateMachine):
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
         self.begin("release", "open the gripper")
+        self.mover.max_acceleration = None
         self._release()
         if self.planned is not None:
             self.planned.detach(self.setup.body.name)
