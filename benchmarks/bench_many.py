@@ -2,7 +2,7 @@
 and clear-table, ``run pick-place-many`` episodes per (task, robot).
 
     python benchmarks/bench_many.py [--episodes 50] [--seed 0] [--robots panda,ur5e_robotiq_2f85]
-                                    [--tasks pick_place_bin_to_bin,pick_place_shelf,clear_table]
+                                    [--tasks pick_place_many,pick_place_shelf,clear_table]
                                     [--workers 1] [--json out.json]
 
 Per (task, robot): episodes with every object placed, objects placed, robot–fixture contacts
@@ -23,7 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-TASKS = ("pick_place_bin_to_bin", "pick_place_shelf", "clear_table")
+TASKS = ("pick_place_many", "pick_place_shelf", "clear_table")
 ROBOTS = ("panda", "ur5e_robotiq_2f85")
 
 

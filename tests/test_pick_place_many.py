@@ -20,7 +20,7 @@ from robocfg.runners.pick_place_many import PickPlaceManyRunner
 
 @pytest.fixture(scope="module")
 def bin_to_bin():
-    return load_task(catalog.find("tasks", "pick_place_bin_to_bin"))
+    return load_task(catalog.find("tasks", "pick_place_many"))
 
 
 def _variant(tmp_path, task, change) -> object:
