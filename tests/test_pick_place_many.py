@@ -172,3 +172,16 @@ def test_grasps_the_filter_drops_touch_a_neighbour_in_pybullet_too(monkeypatch):
     assert rejected and accepted
     assert all(d < margin + 0.004 for d in rejected), rejected  # PyBullet finds them close (hulls: ±4 mm)
     assert all(d > 0.001 for d in accepted), min(accepted)  # and the kept ones clear
+
+
+def test_an_episode_gives_the_same_record_alone_or_after_another(bin_to_bin):
+    """Same seed ⇒ same record, whatever ran before it in the world (what --workers and --resume
+    rely on): the objects are spawned per episode, the planner's model refreshed per move."""
+    from robocfg.engine import open_session
+
+    with open_session(bin_to_bin, RunOptions(seed=5)) as session:
+        session.run(0)
+        after = session.run(1)
+    with open_session(bin_to_bin, RunOptions(seed=5)) as session:
+        alone = session.run(1)
+    assert after == alone
