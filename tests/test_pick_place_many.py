@@ -105,9 +105,7 @@ def test_bin_to_bin_places_all_five_without_touching_a_fixture(bin_to_bin):
 
 
 def test_shelf_placing_puts_each_object_on_the_level_and_withdraws_through_the_front():
-    # the UR5e: on the Panda, a released object sometimes stays stuck to a finger and rises with
-    # it (the retract then fails naming that; rates in docs/benchmarks.md)
-    task = load_task(catalog.find("tasks", "pick_place_shelf"), robot_override="ur5e_robotiq_2f85")
+    task = load_task(catalog.find("tasks", "pick_place_shelf"))
     (ep,) = PickPlaceManyRunner(task, RunOptions(seed=0, episodes=1)).run().report.episodes
     assert ep.success, ep.reason
     assert ep.robot_fixture_contacts == 0, ep.first_contact
