@@ -234,7 +234,8 @@ class _StateMachine:
         """A grasp chosen from the object's geometry (:mod:`robocfg.grasp.object_grasp`): groups of
         candidates, best first; within the first group that the arm can reach, the one needing the
         least joint travel (largest |Δq|, rad) to reach the pre-grasp pose and from there the pose
-        above the place point; the smaller wrist turn breaks ties. (IK can land on a far branch for
+        above the place point, among those whose straight approach and lower lines have continuous
+        IK when there are any; the smaller wrist turn breaks ties. (IK can land on a far branch for
         one of two half-turn twins, e.g. a Panda's shoulder flipped by ≈ 3 rad, or a wrist that
         must wind round a joint limit to carry.)"""
         groups = self._grasp_groups(lying)
@@ -243,23 +244,36 @@ class _StateMachine:
         R_now = self.arm.ee_pose()[:3, :3]
         q0 = self.arm.joint_positions()
 
-        def travel(g: Grasp) -> float:
+        def travel(g: Grasp) -> tuple[bool, float]:
+            """(does a straight approach or lower line break, joint travel in rad); inf: unreachable."""
             shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
             T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
-            cost, q = 0.0, q0
-            for T in (T_pre, _shifted(T_pre, shift)):
+            T_grasp = ee_pose_from_grasp(g, self.cfg)
+            cost, q, broken = 0.0, q0, False
+            for T, T_down in ((T_pre, T_grasp), (_shifted(T_pre, shift), _shifted(T_grasp, shift))):
                 res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
                 if not res.converged:
-                    return math.inf
+                    return True, math.inf
                 cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
-            return cost
+                broken = broken or not self._line_continuous(q, T_down)
+            return broken, cost
 
         for group in groups:
             cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
             costs = [travel(g) for g in cands]
-            if min(costs) < math.inf:
-                return cands[int(np.argmin(costs))]
+            if min(c for _, c in costs) < math.inf:
+                return cands[min(range(len(cands)), key=lambda i: costs[i])]
         return groups[0][0]
+
+    def _line_continuous(self, q: np.ndarray, T_goal: np.ndarray) -> bool:
+        """Whether the straight EE line from FK(``q``) down to ``T_goal`` (the approach, or the
+        lower at the place point) has continuous IK: a candidate whose line crosses a wrist or
+        shoulder branch would fail there, so its twin is preferred."""
+        try:
+            self.mover.straight_waypoints(q, T_goal)
+        except MoveFailed:
+            return False
+        return True
 
     def _grasp_groups(self, lying: LyingObject) -> list[list[Grasp]]:
         """Candidate grasps from the object's geometry, grouped, best group first."""
