@@ -10,7 +10,8 @@ import pytest
 import yaml
 from _cli import run_main
 
-from robocfg.assets.draft import draft_robot, render_yaml
+from robocfg.assets.draft import draft_robot
+from robocfg.assets.draft_yaml import render_yaml
 from robocfg.assets.urdf_xml import parse_urdf
 from robocfg.checks import load_robot
 

@@ -21,7 +21,7 @@ def new_robot(
     """Draft a robot YAML from a URDF, or from a URDF plus attachments. Arm chain, gripper, EE
     link, TCP, R_ee_graspnet and a home pose found by IK with the tool down; the draft is validated
     and what a person must still check is printed. Exit 1 if the draft does not validate."""
-    from robocfg.assets.draft import render_yaml
+    from robocfg.assets.draft_yaml import render_yaml
     from robocfg.checks import load_robot
     from robocfg.config import catalog
     from robocfg.errors import ConfigError, RobocfgError
