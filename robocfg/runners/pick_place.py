@@ -23,15 +23,15 @@ from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
-from robocfg.runners.pick_place_machine import (
+from robocfg.runners.pick_place_machine import _StateMachine
+from robocfg.runners.pick_place_report import EpisodeResult, PickPlaceReport, summarise
+from robocfg.runners.pick_place_setup import (
     EpisodeSetup,
-    _StateMachine,
     _Tools,
     not_simulated,
     planned_drive,
     reactive_drive,
 )
-from robocfg.runners.pick_place_report import EpisodeResult, PickPlaceReport, summarise
 
 __all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episode_setup", "episode_setups",
            "run_pick_place"]

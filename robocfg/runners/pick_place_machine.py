@@ -14,30 +14,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from dataclasses import replace
 
 import numpy as np
 
-from robocfg.assets.object_shape import ObjectShape, object_shape
-from robocfg.checks.grip_force import PadForce, grip_budget
+from robocfg.assets.object_shape import object_shape
+from robocfg.checks.grip_force import grip_budget
 from robocfg.config.commands import PickPlaceParams
-from robocfg.config.scene import Body
-from robocfg.geometry import quat_to_matrix, rotation_angle
-from robocfg.grasp.gripper_model import GripperBoxes
-from robocfg.grasp.object_grasp import (
-    LyingObject,
-    mesh_grasps,
-    suction_grasps,
-    top_down_groups,
-    usable_width,
-)
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
+from robocfg.geometry import quat_to_matrix
+from robocfg.grasp.object_grasp import LyingObject
+from robocfg.kinematics.frames import ee_pose_from_grasp
 from robocfg.motion.moves import ArmMover, MoveFailed, grasp_hint
+from robocfg.runners.pick_place_grasp_choice import GraspChoice, shifted
 from robocfg.runners.pick_place_report import EpisodeResult, PhaseRecord
-
-if TYPE_CHECKING:
-    from robocfg.sim.world import World
+from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
 
 Log = Callable[[str], None]
 SETTLE_POLL = 4  # physics steps between checks while waiting
@@ -45,76 +35,13 @@ SETTLE_POLL = 4  # physics steps between checks while waiting
 # drop of a few mm sets an object rocking, and one standing on a narrow base (a duck on its belly)
 # then topples after the fingers have left.
 RELEASE_CLEARANCE = 0.001
-SUCTION_PRESS = 0.002  # m: a suction cup is driven this far into the top face
 # Bullet lets a ball or a lying cylinder creep and roll away on a level plane from rest; a little
 # rolling/spinning friction (m) on round objects stops that artefact without changing the grasp.
 ROLLING_FRICTION = 1e-3
 REST_TOLERANCE = 1e-4  # m: an object spawned further than this from resting on its support is moved onto it
 
 
-@dataclass(frozen=True)
-class EpisodeSetup:
-    """What an episode randomised: object body, its yaw (rad), place point (x, y in m), seed."""
-
-    index: int
-    seed: int
-    body: Body
-    yaw: float  # rad
-    place_xy: np.ndarray
-
-
-@dataclass(frozen=True)
-class _Tools:
-    """Per-run helpers shared by every episode: kinematic model, scaled joint limits, with
-    ``motion: reactive`` the follow-target controller driving the free-space moves (with ``motion:
-    planned``, the global planner), the object's geometry
-    (:class:`~robocfg.assets.object_shape.ObjectShape`; None: read from the episode's body) and the
-    parallel gripper's measured boxes (:class:`~robocfg.grasp.gripper_model.GripperBoxes`; None for
-    suction) and pad force (:class:`~robocfg.checks.grip_force.PadForce`; None for suction)."""
-
-    model: Any
-    limits: Any
-    reactive: Any = None
-    planned: Any = None  # motion: planned — a robocfg.planning.drive.PlannedDrive
-    shape: ObjectShape | None = None
-    boxes: GripperBoxes | None = None
-    pad_force: PadForce | None = None  # each pad's normal force at the force limit (parallel grippers)
-
-
-def reactive_drive(robot, world: World, arm_name: str, params: PickPlaceParams, shape: ObjectShape):
-    """The controller for ``motion: reactive`` (built once per run: it is expensive), else None."""
-    if params.motion != "reactive":
-        return None
-    from robocfg.motion.reactive_drive import build_reactive_drive
-
-    # the held object's centre beyond the TCP along the tool axis (m), and its bounding radius (m)
-    top = float(shape.posed(quat_to_matrix(params.object.quaternion_xyzw()))[:, 2].max())
-    beyond = top - SUCTION_PRESS if world.robot.arm(arm_name).require_gripper().grasps_at_surface else 0.0
-    radius = float(np.max(np.linalg.norm(shape.vertices, axis=1)))
-    return build_reactive_drive(robot, world, arm_name, velocity_scale=params.speed_scale, payload=(beyond, radius))
-
-
-def not_simulated(s: EpisodeSetup, phase: str, reason: str) -> EpisodeResult:
-    """The record of an episode failed before simulating (the object never moved)."""
-    start = [round(float(v), 6) for v in s.body.position]
-    return EpisodeResult(
-        index=s.index, seed=s.seed, success=False, failed_phase=phase, reason=reason, object_start=start,
-        object_start_yaw_deg=round(math.degrees(s.yaw), 4), place_target=[round(float(v), 6) for v in s.place_xy],
-        object_final=start, place_error=round(float(np.linalg.norm(np.asarray(start[:2]) - s.place_xy)), 6),
-        tilt_deg=0.0, lift_rise=None, mass=round(s.body.mass, 6), friction=round(s.body.friction, 6),
-        sim_time=0.0, steps=0, phases=[])
-
-
-def planned_drive(robot, world: World, model, params: PickPlaceParams):
-    """The global planner for ``motion: planned`` (built once per run), else None."""
-    if params.motion != "planned":
-        return None
-    from robocfg.planning.drive import build_planned_drive
-
-    return build_planned_drive(robot, world, model)
-
-
-class _StateMachine:
+class _StateMachine(GraspChoice):
     def __init__(self, world, arm, tools: _Tools, params: PickPlaceParams, setup: EpisodeSetup, recorder,
                  log: Log | None, body_id: int | None = None):
         self.world, self.params, self.setup, self.recorder = world, params, setup, recorder
@@ -162,7 +89,7 @@ class _StateMachine:
         self._limit_acceleration()
         self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
         z0 = self.world.body_pose(self.obj)[0][2]
-        T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
+        T_lift = shifted(T_grasp, [0, 0, p.lift_height])
         self.mover.move(T_lift, straight=True)
         self._verify_lift(z0)
         # Carry the object so that *it* lands on the place point: keep its offset from the EE.
@@ -189,7 +116,7 @@ class _StateMachine:
         if self.planned is not None:
             self.planned.detach(self.setup.body.name)
         self.begin("retract", "move up and away")
-        self.mover.move(_shifted(T_place, [0, 0, p.above_height]), straight=True)
+        self.mover.move(shifted(T_place, [0, 0, p.above_height]), straight=True)
         self.close_phase(True)
         self.mover.settle(0.3)
         self._check_placed()
@@ -229,82 +156,6 @@ class _StateMachine:
         T_obj = np.eye(4)
         T_obj[:3, :3], T_obj[:3, 3] = quat_to_matrix(quat), pos
         self.planned.attach(self.setup.body.name, self.setup.body, np.linalg.inv(self.arm.ee_pose()) @ T_obj)
-
-    def _choose_grasp(self, lying: LyingObject) -> Grasp:
-        """A grasp chosen from the object's geometry (:mod:`robocfg.grasp.object_grasp`): groups of
-        candidates, best first; within the first group that the arm can reach, the one needing the
-        least joint travel (largest |Δq|, rad) to reach the pre-grasp pose and from there the pose
-        above the place point, among those whose straight approach and lower lines have continuous
-        IK when there are any; the smaller wrist turn breaks ties. (IK can land on a far branch for
-        one of two half-turn twins, e.g. a Panda's shoulder flipped by ≈ 3 rad, or a wrist that
-        must wind round a joint limit to carry.)"""
-        groups = self._grasp_groups(lying)
-        if not groups:
-            raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
-        R_now = self.arm.ee_pose()[:3, :3]
-        q0 = self.arm.joint_positions()
-
-        def travel(g: Grasp) -> tuple[bool, float]:
-            """(does a straight approach or lower line break, joint travel in rad); inf: unreachable."""
-            shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
-            T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
-            T_grasp = ee_pose_from_grasp(g, self.cfg)
-            cost, q, broken = 0.0, q0, False
-            for T, T_down in ((T_pre, T_grasp), (_shifted(T_pre, shift), _shifted(T_grasp, shift))):
-                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
-                if not res.converged:
-                    return True, math.inf
-                cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
-                broken = broken or not self._line_continuous(q, T_down)
-            return broken, cost
-
-        for group in groups:
-            cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
-            costs = [travel(g) for g in cands]
-            if min(c for _, c in costs) < math.inf:
-                return cands[min(range(len(cands)), key=lambda i: costs[i])]
-        return groups[0][0]
-
-    def _line_continuous(self, q: np.ndarray, T_goal: np.ndarray) -> bool:
-        """Whether the straight EE line from FK(``q``) down to ``T_goal`` (the approach, or the
-        lower at the place point) has continuous IK: a candidate whose line crosses a wrist or
-        shoulder branch would fail there, so its twin is preferred."""
-        try:
-            self.mover.straight_waypoints(q, T_goal)
-        except MoveFailed:
-            return False
-        return True
-
-    def _grasp_groups(self, lying: LyingObject) -> list[list[Grasp]]:
-        """Candidate grasps from the object's geometry, grouped, best group first."""
-        p = self.params
-        if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
-            return [suction_grasps(lying, SUCTION_PRESS)]
-        if self.boxes is None:
-            raise MoveFailed("grasp_choice", "the gripper's geometry was not measured")
-        groups = top_down_groups(lying, self.boxes)
-        if p.grasp_depth is not None:  # the task fixes the TCP height relative to the object's centre
-            z = float(lying.position[2]) + p.grasp_depth
-            groups = [[Grasp(np.array([*g.center[:2], z]), g.rotation, g.width) for g in grp] for grp in groups]
-        if self.setup.body.shape == "mesh":
-            rng = np.random.default_rng([self.setup.seed, 1])
-            meshes = mesh_grasps(lying, self.boxes, rng, p.above_height)
-            groups = [[g, _half_turn(g)] for g in meshes] + groups
-        return groups
-
-    def _no_grasp_reason(self, lying: LyingObject) -> str:
-        if self.boxes is None:
-            return "no grasp found"
-        narrow = lying.shape.min_horizontal_width(lying.rotation)
-        usable = usable_width(self.boxes)
-        if narrow > usable:
-            return (f"no grasp found: the object ({narrow * 1000:.1f} mm across its narrowest horizontal side) "
-                    f"does not fit the open fingers ({usable * 1000:.1f} mm usable)")
-        sweep = self.boxes.closing_sweep(narrow)
-        tip = float(sweep.hi[sweep.finger, 0].max())
-        return (f"no grasp height: closing to {narrow * 1000:.1f} mm the fingertips reach {tip * 1000:.0f} mm past the "
-                f"TCP, so with them above the support and the palm above the object's top the pads cannot reach the "
-                f"object ({(lying.top_z - lying.bottom_z) * 1000:.0f} mm tall)")
 
     def _rest_on_support(self) -> np.ndarray:
         """Put the object on the surface below it (its lowest point on the support, whatever its
@@ -411,16 +262,3 @@ class _StateMachine:
             mass=round(b.mass, 6), friction=round(b.friction, 6),
             sim_time=round(self.world.t, 6), steps=self.world.steps, phases=self.phases,
         )
-
-
-def _half_turn(g: Grasp) -> Grasp:
-    """The same grasp turned half a turn about its approach axis (fingers swapped)."""
-    return Grasp(g.center, g.rotation @ np.diag([1.0, -1.0, -1.0]), g.width)
-
-
-def _shifted(T: np.ndarray, d) -> np.ndarray:
-    out = T.copy()
-    out[:3, 3] += np.asarray(d, float)
-    return out
-
-

@@ -30,9 +30,9 @@ from robocfg.engine.registry import register_task
 from robocfg.engine.session import EpisodeSession, EpisodicRunner
 from robocfg.errors import ConfigError, Problem
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
-from robocfg.runners.pick_place_machine import EpisodeSetup, _Tools
 from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch, ObjectMachine, Spot
 from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
+from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
 
 BLOCK = "pick_place_many"
 

@@ -31,12 +31,8 @@ from robocfg.geometry import quat_to_matrix, rotation_angle
 from robocfg.grasp.object_grasp import LyingObject
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
 from robocfg.motion.moves import MoveFailed
-from robocfg.runners.pick_place_machine import (
-    RELEASE_CLEARANCE,
-    SETTLE_POLL,
-    _shifted,
-    _StateMachine,
-)
+from robocfg.runners.pick_place_grasp_choice import shifted as _shifted
+from robocfg.runners.pick_place_machine import RELEASE_CLEARANCE, SETTLE_POLL, _StateMachine
 
 if TYPE_CHECKING:
     from robocfg.planning.drive import PlannedDrive

@@ -1,0 +1,135 @@
+"""Which grasp a pick-place episode uses: candidates from the object's geometry
+(:mod:`robocfg.grasp.object_grasp`: top-down groups, antipodal pairs on a mesh, the top face for
+a suction cup), then, within the first group the arm can reach, the one needing the least joint
+travel and whose straight approach and lower lines have continuous IK.
+
+A base class of the episode's state machine (:class:`robocfg.runners.pick_place_machine._StateMachine`
+and its several-object subclass): the choice reads the episode's arm, model, mover and measured
+gripper, declared below, and is kept here because it is one concept of its own (≈ 100 lines).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from robocfg.config.commands import PickPlaceParams
+from robocfg.geometry import rotation_angle
+from robocfg.grasp.gripper_model import GripperBoxes
+from robocfg.grasp.object_grasp import (
+    LyingObject,
+    mesh_grasps,
+    suction_grasps,
+    top_down_groups,
+    usable_width,
+)
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
+from robocfg.motion.moves import ArmMover, MoveFailed
+from robocfg.runners.pick_place_setup import SUCTION_PRESS, EpisodeSetup
+
+if TYPE_CHECKING:
+    from robocfg.config.robot import ArmConfig
+    from robocfg.sim.gripper.base import Gripper
+    from robocfg.sim.robot import ArmHandle
+
+
+class GraspChoice:
+    """The grasp-choosing part of one episode (set by the state machine's ``__init__``)."""
+
+    arm: ArmHandle
+    cfg: ArmConfig
+    params: PickPlaceParams
+    setup: EpisodeSetup
+    model: Any  # robocfg.kinematics.model.KinematicModel
+    mover: ArmMover
+    gripper: Gripper
+    boxes: GripperBoxes | None
+
+    def _choose_grasp(self, lying: LyingObject) -> Grasp:
+        """A grasp chosen from the object's geometry (:mod:`robocfg.grasp.object_grasp`): groups of
+        candidates, best first; within the first group that the arm can reach, the one needing the
+        least joint travel (largest |Δq|, rad) to reach the pre-grasp pose and from there the pose
+        above the place point, among those whose straight approach and lower lines have continuous
+        IK when there are any; the smaller wrist turn breaks ties. (IK can land on a far branch for
+        one of two half-turn twins, e.g. a Panda's shoulder flipped by ≈ 3 rad, or a wrist that
+        must wind round a joint limit to carry.)"""
+        groups = self._grasp_groups(lying)
+        if not groups:
+            raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
+        R_now = self.arm.ee_pose()[:3, :3]
+        q0 = self.arm.joint_positions()
+
+        def travel(g: Grasp) -> tuple[bool, float]:
+            """(does a straight approach or lower line break, joint travel in rad); inf: unreachable."""
+            shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
+            T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
+            T_grasp = ee_pose_from_grasp(g, self.cfg)
+            cost, q, broken = 0.0, q0, False
+            for T, T_down in ((T_pre, T_grasp), (shifted(T_pre, shift), shifted(T_grasp, shift))):
+                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
+                if not res.converged:
+                    return True, math.inf
+                cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
+                broken = broken or not self._line_continuous(q, T_down)
+            return broken, cost
+
+        for group in groups:
+            cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+            costs = [travel(g) for g in cands]
+            if min(c for _, c in costs) < math.inf:
+                return cands[min(range(len(cands)), key=lambda i: costs[i])]
+        return groups[0][0]
+
+    def _line_continuous(self, q: np.ndarray, T_goal: np.ndarray) -> bool:
+        """Whether the straight EE line from FK(``q``) down to ``T_goal`` (the approach, or the
+        lower at the place point) has continuous IK: a candidate whose line crosses a wrist or
+        shoulder branch would fail there, so its twin is preferred."""
+        try:
+            self.mover.straight_waypoints(q, T_goal)
+        except MoveFailed:
+            return False
+        return True
+
+    def _grasp_groups(self, lying: LyingObject) -> list[list[Grasp]]:
+        """Candidate grasps from the object's geometry, grouped, best group first."""
+        p = self.params
+        if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
+            return [suction_grasps(lying, SUCTION_PRESS)]
+        if self.boxes is None:
+            raise MoveFailed("grasp_choice", "the gripper's geometry was not measured")
+        groups = top_down_groups(lying, self.boxes)
+        if p.grasp_depth is not None:  # the task fixes the TCP height relative to the object's centre
+            z = float(lying.position[2]) + p.grasp_depth
+            groups = [[Grasp(np.array([*g.center[:2], z]), g.rotation, g.width) for g in grp] for grp in groups]
+        if self.setup.body.shape == "mesh":
+            rng = np.random.default_rng([self.setup.seed, 1])
+            meshes = mesh_grasps(lying, self.boxes, rng, p.above_height)
+            groups = [[g, half_turn(g)] for g in meshes] + groups
+        return groups
+
+    def _no_grasp_reason(self, lying: LyingObject) -> str:
+        if self.boxes is None:
+            return "no grasp found"
+        narrow = lying.shape.min_horizontal_width(lying.rotation)
+        usable = usable_width(self.boxes)
+        if narrow > usable:
+            return (f"no grasp found: the object ({narrow * 1000:.1f} mm across its narrowest horizontal side) "
+                    f"does not fit the open fingers ({usable * 1000:.1f} mm usable)")
+        sweep = self.boxes.closing_sweep(narrow)
+        tip = float(sweep.hi[sweep.finger, 0].max())
+        return (f"no grasp height: closing to {narrow * 1000:.1f} mm the fingertips reach {tip * 1000:.0f} mm past the "
+                f"TCP, so with them above the support and the palm above the object's top the pads cannot reach the "
+                f"object ({(lying.top_z - lying.bottom_z) * 1000:.0f} mm tall)")
+
+
+def half_turn(g: Grasp) -> Grasp:
+    """The same grasp turned half a turn about its approach axis (fingers swapped)."""
+    return Grasp(g.center, g.rotation @ np.diag([1.0, -1.0, -1.0]), g.width)
+
+
+def shifted(T: np.ndarray, d) -> np.ndarray:
+    out = T.copy()
+    out[:3, 3] += np.asarray(d, float)
+    return out
