@@ -88,6 +88,22 @@ def test_an_object_out_of_reach_is_refused_before_simulating(tmp_path, bin_to_bi
                and "out of the arm's reach (nominal point" in p.message for p in exc.value.problems)
 
 
+def test_validate_reports_the_reach_error_that_run_refuses(tmp_path, bin_to_bin, capsys, monkeypatch):
+    """``validate`` makes the same IK reach check as ``run`` (before simulating): exit 2, the
+    object's position line, with the phase."""
+    from _cli import run_main
+
+    def far(d):
+        d["pick_place_many"]["objects"][0]["position"] = [1.5, 0.0, 0.025]
+    path = _variant(tmp_path, bin_to_bin, far)
+    code, _out, err = run_main(["validate", str(path)], capsys, monkeypatch)
+    assert code == 2
+    assert "pick_place_many.objects[0].position: pre_grasp: object 'red'" in err
+    assert "out of the arm's reach (nominal point" in err
+    code, _out, err = run_main(["validate", str(bin_to_bin.path)], capsys, monkeypatch)
+    assert code == 0, err
+
+
 def test_bin_to_bin_places_all_five_without_touching_a_fixture(bin_to_bin):
     runner = PickPlaceManyRunner(bin_to_bin, RunOptions(seed=0, episodes=1))
     runner.check()

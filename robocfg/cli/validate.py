@@ -43,13 +43,17 @@ def validate(
             # The checks (numpy, URDF parsing, the task models) are imported once a file has parsed:
             # a file refused by the size and nesting pre-scan is reported without them.
             from robocfg.checks import load_robot, load_task
+            from robocfg.checks.task import CheckedTask
 
             checked = load_robot(f, strict) if kind == "robot" else load_task(f, strict, overrides=changes)
             warnings = checked.warnings
-            if kind == "task":  # poses out of the arm's reach (IK, no simulation)
-                from robocfg.motion.reach import reach_warnings
+            if isinstance(checked, CheckedTask):  # the kind's checks needing kinematics, not simulation (IK reach)
+                from robocfg.engine.registry import runner_for
 
-                warnings = warnings + reach_warnings(checked)  # type: ignore[arg-type]
+                static = runner_for(checked.config.task).static_problems(checked)
+                if any(p.severity == "error" for p in static):
+                    raise ConfigError(static)
+                warnings = warnings + static
         except ConfigError as exc:
             problems = exc.problems
         errors = [p for p in problems if p.severity == "error"]

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
     from robocfg.config.robot import RobotConfig
     from robocfg.engine.dataset import ReplayScene
+    from robocfg.errors import Problem
 
 
 @dataclass
@@ -159,6 +160,13 @@ class TaskRunner(ABC):
             raise ConfigError([Problem("--episodes", None, None, "",
                                        f"'run {self.kind}' runs one episode (it has nothing to randomise), "
                                        f"got {self.options.episodes}")])
+
+    @classmethod
+    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
+        """What ``validate`` reports for a task of this kind beyond its schema and cross-checks:
+        checks that need no simulation but do need the kinematics (IK reach of the task's poses),
+        with their severity. ``run`` makes the same checks in :meth:`check`. Default: none."""
+        return []
 
     @abstractmethod
     def run(self) -> RunOutput: ...

@@ -61,14 +61,6 @@ class ReachProblem:
         return task.doc.problem(self.loc, f"{self.phase}: {self.reason}", "warning")
 
 
-def reach_warnings(task: CheckedTask) -> list[Problem]:
-    """``validate``'s reach warnings for a task: one per unreachable pose of a pick-place task
-    (nominal point or region corner, naming the phase that would fail); none for other kinds."""
-    if task.config.task != "pick_place":
-        return []
-    return [r.problem(task) for r in pick_place_reach(task)]
-
-
 def pick_place_reach(task: CheckedTask, arm: str | None = None, params: PickPlaceParams | None = None) -> list[ReachProblem]:
     """Every unreachable pose of the pick-place task ``task`` for ``arm`` (default: the first);
     ``params``: its parameters with world positions (default: resolved from the task)."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,6 +32,10 @@ from robocfg.runners.pick_place_setup import (
     planned_drive,
     reactive_drive,
 )
+
+if TYPE_CHECKING:
+    from robocfg.checks.task import CheckedTask
+    from robocfg.errors import Problem
 
 __all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episode_setup", "episode_setups",
            "run_pick_place"]
@@ -161,6 +165,14 @@ class PickPlaceRunner(EpisodicRunner):
         "(observations, the joint-target + gripper actions that drove the robot, phase labels, images of "
         "the task's cameras) and the kept ones are written as a LeRobot v3.0 or robomimic HDF5 dataset; "
         "`robocfg dataset replay` re-simulates an episode from those actions.")
+
+    @classmethod
+    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
+        """Poses out of the arm's reach (IK, tool down; nominal point or region corner), as warnings
+        naming the phase that would fail: ``run`` then fails those episodes without simulating."""
+        from robocfg.motion.reach import pick_place_reach
+
+        return [r.problem(task) for r in pick_place_reach(task, arm)]
 
     def open_session(self) -> PickPlaceSession:
         return PickPlaceSession(self.task, self.options)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +34,9 @@ from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
 from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch, ObjectMachine, Spot
 from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
 from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
+
+if TYPE_CHECKING:
+    from robocfg.checks.task import CheckedTask
 
 BLOCK = "pick_place_many"
 
@@ -211,10 +215,16 @@ class PickPlaceManyRunner(EpisodicRunner):
 
     def check(self) -> None:
         super().check()
-        self._reach = reach_many(self.task, self.options.arm)
+        self._reach = self.static_problems(self.task, self.options.arm)
         errors = [p for p in self._reach if p.severity == "error"]
         if errors:
             raise ConfigError(errors)
+
+    @classmethod
+    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
+        """Every object's and place spot's poses out of the arm's reach (:func:`reach_many`): a nominal
+        pose is an error, a region corner a warning."""
+        return reach_many(task, arm)
 
     def open_session(self) -> ManySession:
         session = ManySession(self.task, self.options)
