@@ -23,7 +23,7 @@ from robocfg.checks.grip_force import grip_budget
 from robocfg.config.commands import PickPlaceParams
 from robocfg.geometry import quat_to_matrix
 from robocfg.grasp.object_grasp import LyingObject
-from robocfg.kinematics.frames import ee_pose_from_grasp
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
 from robocfg.motion.moves import ArmMover, MoveFailed, grasp_hint
 from robocfg.runners.pick_place_grasp_choice import GraspChoice, shifted
 from robocfg.runners.pick_place_report import EpisodeResult, PhaseRecord
@@ -76,22 +76,7 @@ class _StateMachine(GraspChoice):
         self.R0 = quat_to_matrix(obj_quat)  # as it came to rest: what the place must reproduce
         lying = LyingObject(self.shape, obj_pos, quat_to_matrix(obj_quat), self._support_height(obj_pos[:2]))
         self.support_z = lying.support_z
-        grasp = self._choose_grasp(lying)
-        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
-        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
-
-        self.begin("pre_grasp", "move above the object")
-        self._free_move(T_pre)
-        self.begin("approach", "down to grasp height")
-        self.mover.move(T_grasp, straight=True)
-        self.begin("grasp", "close the gripper")
-        self.mover.close_until_held(self.obj, p.timeouts.grasp)
-        self._limit_acceleration()
-        self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
-        z0 = self.world.body_pose(self.obj)[0][2]
-        T_lift = shifted(T_grasp, [0, 0, p.lift_height])
-        self.mover.move(T_lift, straight=True)
-        self._verify_lift(z0)
+        T_lift = self._pick(self._choose_grasp(lying))
         # Carry the object so that *it* lands on the place point: keep its offset from the EE.
         obj_now, quat_now = self.world.body_pose(self.obj)
         ee_now = self.arm.ee_pose()[:3, 3]
@@ -120,6 +105,26 @@ class _StateMachine(GraspChoice):
         self.close_phase(True)
         self.mover.settle(0.3)
         self._check_placed()
+
+    def _pick(self, grasp: Grasp) -> np.ndarray:
+        """Phases pre_grasp → approach → grasp → lift with ``grasp``, checked that the object rose
+        with the hand; returns the EE pose where the lift ended (4×4, world)."""
+        p = self.params
+        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
+        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
+        self.begin("pre_grasp", "move above the object")
+        self._free_move(T_pre)
+        self.begin("approach", "down to grasp height")
+        self.mover.move(T_grasp, straight=True)
+        self.begin("grasp", "close the gripper")
+        self.mover.close_until_held(self.obj, p.timeouts.grasp)
+        self._limit_acceleration()
+        self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
+        z0 = self.world.body_pose(self.obj)[0][2]
+        T_lift = shifted(T_grasp, [0, 0, p.lift_height])
+        self.mover.move(T_lift, straight=True)
+        self._verify_lift(z0)
+        return T_lift
 
     def begin(self, name: str, what: str) -> None:
         if self._phase is not None:

@@ -186,21 +186,7 @@ class ObjectMachine(_StateMachine):
             self.plan_grasp()
         if self.grasp is None:
             raise MoveFailed("grasp_choice", self.grasp_failure())
-        grasp = self.grasp
-        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
-        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
-        self.begin("pre_grasp", "move above the object")
-        self._free_move(T_pre)
-        self.begin("approach", "down to grasp height")
-        self.mover.move(T_grasp, straight=True)
-        self.begin("grasp", "close the gripper")
-        self.mover.close_until_held(self.obj, p.timeouts.grasp)
-        self._limit_acceleration()
-        self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
-        z0 = self.world.body_pose(self.obj)[0][2]
-        T_lift = _shifted(T_grasp, [0, 0, p.lift_height])
-        self.mover.move(T_lift, straight=True)
-        self._verify_lift(z0)
+        T_lift = self._pick(self.grasp)
         obj_now, quat_now = self.world.body_pose(self.obj)
         offset = self.arm.ee_pose()[:3, 3] - obj_now
         # its lowest point as it now hangs in the hand (it may have turned a little in the grasp)
