@@ -36,3 +36,40 @@ def test_kr210_runs_the_relative_task():
     e = report.episodes[0]
     assert e.success, (e.failed_phase, e.reason)
     assert np.linalg.norm(e.object_start[:2]) > 1.2  # the cube is where a KR 210 works, not at a desk
+
+
+def test_auto_placement_leaves_reachable_spots_alone():
+    """The default task (``placement: auto``) on the robot it was written for: spots as written,
+    no note (and no reach measured)."""
+    from robocfg.motion.placement import resolve_placement
+
+    task = load_task(catalog.find("tasks", "pick_place"))
+    assert task.config.pick_place.placement == "auto"
+    placed = resolve_placement(task)
+    assert placed.note == "" and placed.reach == []
+    assert list(placed.params.object.position) == list(task.config.pick_place.object.position)
+    assert list(placed.params.place_position) == list(task.config.pick_place.place_position)
+
+
+def test_auto_placement_scales_the_default_task_to_a_kr210():
+    """``validate``'s check and one run of the default pick-place on a KR 210: the Panda's spots,
+    out of its reach, scaled about the base by the ratio of the reaches; reachable; placed."""
+    from robocfg.motion.placement import resolve_placement
+    from robocfg.runners.pick_place import PickPlaceRunner
+
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="kuka_kr210")
+    assert task.written_robot is not None and task.written_robot.stem == "panda"
+    given = task.config.pick_place
+    assert any(r.nominal for r in pick_place_reach(task, params=given.model_copy(update={"placement": "world"})))
+    placed = resolve_placement(task)
+    assert placed.reach == [] and PickPlaceRunner.static_problems(task) == []  # validate's check
+    assert "spots scaled to kuka_kr210's reach" in placed.note
+    ratio = placed.params.object.position[0] / given.object.position[0]
+    assert 2.5 < ratio < 4.0  # 2.7 m against 0.8 m
+    np.testing.assert_allclose(placed.params.object.position[:2], np.asarray(given.object.position[:2]) * ratio, atol=1e-9)
+    np.testing.assert_allclose(placed.params.place_position[:2], np.asarray(given.place_position[:2]) * ratio, atol=1e-9)
+    assert placed.params.object.position[2] == given.object.position[2]
+    report, _ = run_pick_place(task, episodes=1, seed=0)
+    e = report.episodes[0]
+    assert e.success, (e.failed_phase, e.reason)
+    assert any("spots scaled" in w for w in report.warnings)

@@ -14,6 +14,7 @@ from robocfg.motion.reach import pick_place_reach
 def _default_task_on(tmp_path, robot: str):
     data = yaml.safe_load(catalog.find("tasks", "pick_place").read_text())
     data["robots"][0]["robot"] = robot
+    data["pick_place"]["placement"] = "world"  # the desk spots as world coordinates, whatever the robot
     path = tmp_path / f"pick_place_{robot}.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path

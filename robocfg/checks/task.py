@@ -55,6 +55,7 @@ class CheckedTask:
     doc: YamlDocument
     robots: list[CheckedRobot]
     warnings: list[Problem] = field(default_factory=list)
+    written_robot: Path | None = None  # the first robot's YAML as the file names it (before --robot / --set)
 
     @property
     def path(self) -> Path:
@@ -94,7 +95,24 @@ def check_task_document(doc: YamlDocument, strict: bool = False, robot_override:
         raise blame_overrides(exc, overrides or {}) from None
     if robot_override is None and not overrides:
         _check_other_variants(original, strict, checked.config.robots[0].robot)
+    checked.written_robot = _written_robot(original)
     return checked
+
+
+def _written_robot(doc: YamlDocument) -> Path | None:
+    """The robot YAML the file names for its first robot (``placement: auto`` scales the spots
+    from its reach); None when it cannot be found (the checks report that)."""
+    robots = doc.data.get("robots") if isinstance(doc.data, dict) else None
+    first = robots[0] if isinstance(robots, list) and robots and isinstance(robots[0], dict) else {}
+    try:
+        if isinstance(first.get("robot"), str):
+            return catalog.find("robots", first["robot"])
+        if isinstance(first.get("robot_config_file"), str):
+            path = (doc.path.parent / first["robot_config_file"]).resolve()
+            return path if path.is_file() else None
+    except NotFound:
+        return None
+    return None
 
 
 def _variant(doc: YamlDocument, robot_override: str | None,

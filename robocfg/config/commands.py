@@ -183,7 +183,7 @@ class PickPlaceParams(Frozen):
 
     object: Body = Field(description="The object to pick (spawned resting on its support).")
     place_position: Vec3 = Field(description="Where the object's centre should end (m, world; see placement); z is ignored (it rests on the support).")
-    placement: Literal["world", "reach"] = Field("world", description="world: object.position and place_position are world coordinates (m). reach: their x and y are in the robot's base frame (x forward, as mounted), in units of the arm's reach with the tool pointing down (e.g. [0.6, -0.2]), so one task fits a desk arm and an industrial arm alike; the randomisation ranges stay in metres.")
+    placement: Literal["world", "reach", "auto"] = Field("world", description="world: object.position and place_position are world coordinates (m). auto: world coordinates written for the robot the file names; a robot that cannot reach them (--robot) gets them scaled about its base by the ratio of the two arms' reaches towards the spots (z and the randomisation ranges kept). reach: their x and y are in the robot's base frame (x forward, as mounted), in units of the arm's reach with the tool pointing down (e.g. [0.6, -0.2]), so one task fits a desk arm and an industrial arm alike; the randomisation ranges stay in metres.")
     randomize: PickPlaceRandomize = Field(default_factory=PickPlaceRandomize)
     above_height: PositiveFloat = Field(0.15, description="TCP height above the grasp point for pre-grasp/transport (m).")
     lift_height: PositiveFloat = Field(0.15, description="How far the object is lifted (m).")

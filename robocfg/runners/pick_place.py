@@ -80,19 +80,20 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         from robocfg.grasp.gripper_model import measure_gripper
         from robocfg.kinematics.model import KinematicModel
         from robocfg.motion.limits import limits_from_robot
-        from robocfg.motion.placement import resolved_params
-        from robocfg.motion.reach import pick_place_reach
+        from robocfg.motion.placement import resolve_placement
 
         robot = self.task.robots[0]
         self.arm_cfg = robot.config.arm(self.options.arm)
-        self.params: PickPlaceParams = resolved_params(self.task, self.arm_cfg.name)  # world positions
+        placement = resolve_placement(self.task, self.arm_cfg.name)
+        self.params: PickPlaceParams = placement.params  # world positions
+        self.placement_note = placement.note
         self.handle = self.world.robot.arm(self.arm_cfg.name)
         shape = object_shape(self.params.object, self.task.path.parent)
         obj = self.params.object
         if shape.file_mass is not None and "mass" not in obj.model_fields_set:  # the URDF's own mass
             self.params = self.params.model_copy(update={"object": obj.model_copy(update={"mass": shape.file_mass})})
         # Poses out of reach (IK, before simulating): a nominal one fails every episode unsimulated.
-        self.reach = pick_place_reach(self.task, self.arm_cfg.name, self.params)
+        self.reach = placement.reach
         self.blocked = next((r for r in self.reach if r.nominal), None)
         model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
         bound_ik_by_iterations(model)  # same seed ⇒ same answers, whatever the machine load
@@ -144,6 +145,7 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         unseen = self.tools.planned.skipped if self.tools.planned is not None else []
         warnings += [f"body {name!r} is a mesh: the planner does not avoid it" for name in unseen]
         warnings += [r.problem(self.task).format() for r in self.reach]
+        warnings += [self.placement_note] if self.placement_note else []
         return PickPlaceReport(task=str(self.task.path), robot=self.task.robots[0].config.name,
                                arm=self.arm_cfg.name, seed=self.seed, summary=summarise(records), episodes=records,
                                warnings=warnings, interrupted=interrupted)
@@ -170,9 +172,9 @@ class PickPlaceRunner(EpisodicRunner):
     def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
         """Poses out of the arm's reach (IK, tool down; nominal point or region corner), as warnings
         naming the phase that would fail: ``run`` then fails those episodes without simulating."""
-        from robocfg.motion.reach import pick_place_reach
+        from robocfg.motion.placement import resolve_placement
 
-        return [r.problem(task) for r in pick_place_reach(task, arm)]
+        return [r.problem(task) for r in resolve_placement(task, arm).reach]
 
     def open_session(self) -> PickPlaceSession:
         return PickPlaceSession(self.task, self.options)
