@@ -38,7 +38,7 @@ class WallContacts:
     def __init__(self):
         self.robot_steps = self.cube_steps = self.steps = 0
 
-    def begin(self, world, arm, obj, phase_of):
+    def begin(self, world, arm, obj, phase_of, phases=(), language=""):
         return _Episode(self, world, obj)
 
     def end(self, rec, index, seed, success, failed_phase, reason):
@@ -46,9 +46,19 @@ class WallContacts:
 
 
 class _Episode:
+    """The sink's tap (``robocfg.engine.dataset.EpisodeTap``): hooked into the world's physics
+    steps from ``begin`` until ``stop``; it sends no commands, so nothing reaches the drives late."""
+
+    lag_steps = 0
+
     def __init__(self, total: WallContacts, world, obj: int):
         self.total, self.world, self.obj = total, world, obj
         self.wall = world.bodies.get("wall")
+        world.step_hooks.append(self.on_step)
+
+    def stop(self) -> None:
+        if self.on_step in self.world.step_hooks:
+            self.world.step_hooks.remove(self.on_step)
 
     def on_step(self) -> None:
         import pybullet as p
