@@ -2,11 +2,14 @@
 bucket, and the cost of a state-only dataset, in CPU time (``time.process_time``: on a shared,
 loaded machine wall time mostly measures the other jobs).
 
-    python benchmarks/bench_control_cost.py --episodes 16 [--task pick_place] [--json out.json]
+    python benchmarks/bench_control_cost.py --episodes 16 [--task pick_place] [--formats lerobot,hdf5] [--json out.json]
 
-One process, two sessions of the same task (seed 0): episode k runs without a dataset and then
-with a state-only LeRobot dataset, alternately, so machine load falls on both alike; figures are
-medians over episodes 1..N (episode 0 warms up). The buckets wrap the named functions with
+One process, one session per row of the same task (seed 0): episode k runs without a dataset and
+then with a state-only dataset of each of ``--formats`` (default: lerobot), in turn, so machine
+load falls on all alike; figures are medians over episodes 1..N (episode 0 warms up, and with it
+the writer's first use: its imports and the file it opens). The cost of a format is the median of
+per-episode CPU ratios (dataset / none); what a run pays once per format — the writer module's
+first import (h5py for hdf5), opening the writer and its ``close()`` — is measured apart (CPU ms, ``fixed_ms``). The buckets wrap the named functions with
 ``process_time`` (a wrapper costs ≈ 1–2 µs a call, included in its bucket; nested calls count
 once, in the outer bucket); "other" is the rest of the episode (world restore, spawning the
 object, the state machine's own checks, the step loop).
@@ -91,12 +94,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--episodes", type=int, default=16)
     ap.add_argument("--task", default="pick_place")
+    ap.add_argument("--formats", default="lerobot", help="comma-separated: lerobot, hdf5")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
+    formats = [f for f in args.formats.split(",") if f]
 
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
+    import robocfg.datasets.sink as sink_module
     from robocfg.datasets.sink import DatasetSink
     from robocfg.engine import RunOptions, open_session
 
@@ -104,20 +110,35 @@ def main() -> None:
     meter.install()
     task = _task(args.task)
     tmp = Path(tempfile.mkdtemp(prefix="bench_control_"))
-    sink = DatasetSink(tmp / "ds", "lerobot", task, extra_info={"task_path": str(task.path), "seed": 0, "arm": None,
-                                                                "robot_override": None})
-    plain, recorded = open_session(task, RunOptions(seed=0)), open_session(task, RunOptions(seed=0, sink=sink))
-    runs: dict[str, list[tuple[float, dict[str, float]]]] = {"none": [], "dataset": []}
+    info = {"task_path": str(task.path), "seed": 0, "arm": None, "robot_override": None}
+    sinks = {f: DatasetSink(tmp / f, f, task, extra_info=info) for f in formats}  # type: ignore[arg-type]
+    sessions = {"none": open_session(task, RunOptions(seed=0))}
+    sessions |= {f: open_session(task, RunOptions(seed=0, sink=sinks[f])) for f in formats}
+    runs: dict[str, list[tuple[float, dict[str, float]]]] = {k: [] for k in sessions}
+    fixed: dict[str, float] = defaultdict(float)
+    make_writer = sink_module.make_writer
+
+    def timed_make_writer(fmt: Any, *a: Any) -> Any:  # the writer's first use: imports, file opened
+        c0 = time.process_time()
+        try:
+            return make_writer(fmt, *a)
+        finally:
+            fixed[fmt] += time.process_time() - c0
+
+    sink_module.make_writer = timed_make_writer
     try:
-        plain.run(0)
-        recorded.run(0)
+        for session in sessions.values():
+            session.run(0)
         for k in range(1, args.episodes + 1):
-            runs["none"].append(_episode(plain, k, meter))
-            runs["dataset"].append(_episode(recorded, k, meter))
-        sink.close()
+            for key, session in sessions.items():
+                runs[key].append(_episode(session, k, meter))
+        for f in formats:
+            c0 = time.process_time()
+            sinks[f].close()
+            fixed[f] += time.process_time() - c0
     finally:
-        plain.close()
-        recorded.close()
+        for session in sessions.values():
+            session.close()
         shutil.rmtree(tmp, ignore_errors=True)
 
     def med(values: list[float]) -> float:
@@ -128,19 +149,22 @@ def main() -> None:
     cpu = med([c for c, _ in none])
     own = med([(c - b.get("stepSimulation", 0.0)) / b.get("stepSimulation", 1.0) for c, b in none])
     buckets = {label: med([b.get(label, 0.0) for _, b in none]) for *_, label in BUCKETS}
-    dataset_cost = med([d[0] / n[0] for n, d in zip(none, runs["dataset"], strict=True)])
+    cost = {f: med([d[0] / n[0] for n, d in zip(none, runs[f], strict=True)]) for f in formats}
     res = {"task": args.task, "episodes": args.episodes, "cpu_per_episode_ms": round(cpu * 1e3, 2),
            "physics_per_episode_ms": round(physics * 1e3, 2), "own_share_of_physics": round(own, 3),
            "buckets_ms": {k: round(v * 1e3, 2) for k, v in buckets.items()},
            "other_ms": round((cpu - physics - sum(buckets.values())) * 1e3, 2),
-           "state_only_dataset_cost": round(dataset_cost, 3)}
+           "state_only_dataset_cost": {f: round(c, 3) for f, c in cost.items()},
+           "dataset_cpu_per_episode_ms": {f: round(med([c for c, _ in runs[f]]) * 1e3, 2) for f in formats},
+           "fixed_ms": {f: round(v * 1e3, 1) for f, v in fixed.items()}}
     print(f"{args.task}: {cpu * 1e3:.1f} ms CPU per episode, {physics * 1e3:.1f} ms in stepSimulation; "
           f"robocfg's own work {own:.1%} of physics (median over {args.episodes} episodes)")
     for label, v in sorted(buckets.items(), key=lambda kv: -kv[1]):
         print(f"  {label:22s} {v * 1e3:7.2f} ms  {v / physics:6.1%} of physics")
     print(f"  {'other':22s} {res['other_ms']:7.2f} ms  {res['other_ms'] / 1e3 / physics:6.1%} of physics")
-    print(f"state-only dataset: {res['state_only_dataset_cost']:.3f}x the CPU of the same episode without "
-          f"(median of per-episode ratios)")
+    for f in formats:
+        print(f"state-only {f} dataset: {cost[f]:.3f}x the CPU of the same episode without (median of per-episode "
+              f"ratios); once per run: {res['fixed_ms'][f]:.1f} ms (writer opened incl. first imports, and closed)")
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=2) + "\n")
 

@@ -7,8 +7,13 @@ size on disk and pyarrow load time of a larger state-only dataset.
 One process, one core: "per core-minute" = successes / (CPU minutes of the run, ``time.process_time``:
 less sensitive to other jobs on a loaded machine than wall time, which is printed too). The
 state-only ratio (dataset / none, CPU) is the cost of sampling, the command gate and writing
-(goal ≤ 1.1×). Camera frames/s: both task cameras rendered once per frame while the arm moves
-(so the wrist camera's view changes every frame), per renderer (``--renderers``:
+(goal ≤ 1.1×). Every row's imports are paid before the timings (a one-episode warm run, and the
+writers' modules — pyarrow for LeRobot, h5py for HDF5 — imported first; their CPU ms are printed
+as ``writer_first_import_ms``, a once-per-process cost no row pays). The rows run one after
+another, so on a loaded machine they differ by ±15 % from noise alone;
+``benchmarks/bench_control_cost.py --formats lerobot,hdf5`` alternates the formats episode by
+episode and gives the per-episode cost. Camera frames/s: both task cameras rendered once per frame
+while the arm moves (so the wrist camera's view changes every frame), per renderer (``--renderers``:
 ``robocfg.sim.camera_rig``: exact, tiny, egl).
 """
 
@@ -16,11 +21,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import importlib
 import json
 import shutil
 import tempfile
 import time
 from pathlib import Path
+
+WRITER_MODULES = {"lerobot": ("pyarrow.parquet", "robocfg.datasets.lerobot"), "hdf5": ("robocfg.datasets.hdf5", "h5py")}
 
 
 def _task(name: str, cameras: bool, size: int = 128):
@@ -94,12 +102,17 @@ def main() -> None:
     from robocfg.sim.quiet import quiet_import
 
     quiet_import()
+    res: dict = {"rows": {}, "writer_first_import_ms": {}}
+    for fmt, modules in WRITER_MODULES.items():  # the writers' imports, once per process, out of the rows
+        c0 = time.process_time()
+        for m in modules:
+            importlib.import_module(m)
+        res["writer_first_import_ms"][fmt] = round((time.process_time() - c0) * 1e3, 1)
     import pyarrow.parquet as pq
 
     tmp = Path(tempfile.mkdtemp(prefix="bench_dataset_"))
     state, cams = _task("pick_place", False), _task("pick_place", True)
     _run(state, 1, args.seed, None, tmp / "warm")  # imports and caches out of the timings
-    res: dict = {"rows": {}}
     res["rows"]["no dataset"] = _run(state, args.episodes, args.seed, None, tmp / "none")
     res["rows"]["state-only lerobot"] = _run(state, args.episodes, args.seed, "lerobot", tmp / "state_lr")
     res["rows"]["state-only hdf5"] = _run(state, args.episodes, args.seed, "hdf5", tmp / "state_h5")
