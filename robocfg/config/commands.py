@@ -52,6 +52,7 @@ class TrajectoryParams(Frozen):
     gridpoints: Annotated[int, Field(ge=10, le=5000)] | None = Field(
         None, description="toppra grid size (default: 100, or 20 per segment for long paths)."
     )
+    placement: Literal["world", "auto"] = Field("world", description="world: Cartesian points are world coordinates (m), used as written. auto: world coordinates written for the robot the file names; a robot that cannot reach them (--robot) gets them moved with its arm: scaled about its arm base by the ratio of the two arms' reaches towards the points (see docs/task-yaml.md).")
 
 
 MOTION_TYPES = ("static", "waypoints", "circle", "figure8")
@@ -135,6 +136,7 @@ class FollowTargetParams(Frozen):
     posture_weight: NonNegFloat = Field(1e-6, description="Weight of the pull towards the home posture (tiny: it must not fight the target).")
     self_collision: bool = Field(True, description="Also keep the robot's non-adjacent links apart.")
     escape: bool = Field(True, description="Local-minimum escape: tangent-plane via points when stalled at an obstacle.")
+    placement: Literal["world", "auto"] = Field("world", description="world: the motion's points, its radius and the obstacles are world coordinates (m), used as written. auto: world coordinates written for the robot the file names; a robot that cannot reach them (--robot) gets them moved with its arm: scaled about its arm base by the ratio of the two arms' reaches towards the points (see docs/task-yaml.md).")
 
     @model_validator(mode="after")
     def _unique_obstacles(self) -> FollowTargetParams:

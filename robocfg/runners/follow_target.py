@@ -18,8 +18,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from robocfg.checks.task import CheckedTask
-from robocfg.config.commands import FollowTargetParams
+from robocfg.config.commands import FollowTargetParams, Motion
 from robocfg.engine.options import RunOptions, option
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import RunOutput, TaskRunner
@@ -63,6 +65,35 @@ class FollowTargetRunner(TaskRunner):
                                            plot=x.plot, arm=o.arm, should_stop=o.should_stop, recording=o.recording))
 
 
+POSE_SAMPLES = 16  # target poses checked for reach over the run
+
+
+def placed_params(task: CheckedTask, arm: str | None, params: FollowTargetParams) -> tuple[FollowTargetParams, str]:
+    """``params`` with the motion (centre, radius, waypoints) and the obstacles (positions,
+    sizes, motions) moved to the running robot's arm for ``placement: auto`` when it cannot reach
+    the target as written (``robocfg.motion.relative``); the line saying so."""
+    from robocfg.motion.relative import PointMap, auto_map
+    from robocfg.motion.targets import TargetMotion
+
+    if params.placement != "auto":
+        return params, ""
+    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
+                          params.orientation, math.radians(params.follow_angle_deg))
+    poses = [target.pose(float(t)) for t in np.linspace(0.0, params.duration, POSE_SAMPLES)]
+    m = auto_map(task, arm, poses, "the target's motion and obstacles")
+    if m is None:
+        return params, ""
+
+    def motion(mo: Motion, pm: PointMap) -> Motion:
+        return mo.model_copy(update={"center": pm.point(mo.center), "radius": pm.length(mo.radius),
+                                     "waypoints": [pm.point(w) for w in mo.waypoints]})
+
+    obstacles = [o.model_copy(update={"position": m.point(o.position), "size": [m.length(v) for v in o.size],
+                                      "motion": None if o.motion is None else motion(o.motion, m)})
+                 for o in params.obstacles]
+    return params.model_copy(update={"motion": motion(params.motion, m), "obstacles": obstacles}), m.note
+
+
 def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool | None = None,
                       record: Path | None = None, plot: Path | None = None,
                       params: FollowTargetParams | None = None, realtime: bool | None = None,
@@ -80,6 +111,7 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
     params = params or task.config.follow_target  # type: ignore[union-attr]
     assert params is not None
     t_wall = time.perf_counter()
+    params, note = placed_params(task, arm, params)
     target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
                           params.orientation, math.radians(params.follow_angle_deg))
     with World(task, gui=gui) as world:
@@ -88,6 +120,8 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
                          params.with_obstacle if with_obstacle is None else with_obstacle)
         run.loop(gui if realtime is None else realtime)
         result = run.finish(plot, t_wall)
+    if note:
+        result.warnings.insert(0, note)
     if not result.reached:
         tol = f"{params.reach_tolerance * 1000:.1f} mm / {math.degrees(params.orientation_tolerance):.2f} deg"
         e = result.position_error_mm

@@ -106,9 +106,29 @@ def plan_task(task: CheckedTask, arm_name: str | None = None):
     def problem(loc: tuple, msg: str):
         return task.doc.problem(("trajectory", "waypoints", *loc), msg)
 
-    wps = resolve_waypoints(list(params.waypoints), limits, home, problem, ik=_ik_fn(task, arm.name, params))
+    waypoints, note = _placed_waypoints(task, arm.name, params)
+    wps = resolve_waypoints(waypoints, limits, home, problem, ik=_ik_fn(task, arm.name, params))
     plan = plan_trajectory(wps.q, limits, params.stop_at_waypoints, params.gridpoints)
+    if note:
+        plan.notes.insert(0, note)
     return params, arm, names, limits, wps, plan
+
+
+def _placed_waypoints(task: CheckedTask, arm_name: str, params: TrajectoryParams) -> tuple[list, str]:
+    """The waypoints, Cartesian ones moved to the running robot's arm for ``placement: auto``
+    when it cannot reach them as written (``robocfg.motion.relative``); the line saying so."""
+    from robocfg.config.types import Pose
+    from robocfg.geometry import pose_matrix
+    from robocfg.motion.relative import auto_map
+
+    waypoints = list(params.waypoints)
+    poses = [pose_matrix(w) for w in waypoints if isinstance(w, Pose)]
+    if params.placement != "auto" or not poses:
+        return waypoints, ""
+    m = auto_map(task, arm_name, poses, "Cartesian waypoints")
+    if m is None:
+        return waypoints, ""
+    return [w.model_copy(update={"position": m.point(w.position)}) if isinstance(w, Pose) else w for w in waypoints], m.note
 
 
 def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):

@@ -1,0 +1,124 @@
+"""Free-space points of a task written for one robot, mapped to the robot that runs it
+(``placement: auto`` of the trajectory and follow-target tasks).
+
+A task's Cartesian points (trajectory waypoints, the follow-target motion and its obstacles) are
+world coordinates written for the robot the file names. When the running robot (``--robot``)
+reaches every one of them with the task's tool orientation (IK), nothing changes. When it does
+not, the points are moved with the arm: ``p' = b_run + k · (p − b_task)``, with ``b`` the world
+position of each arm's ``base_link`` (at its home pose) and ``k`` the ratio of the two arms'
+reaches along the direction from the arm base to the points' middle (the farthest distance at
+which IK reaches the TCP with the tool orientation of the first point). Lengths (radius, obstacle
+sizes) are scaled by ``k``. A desk arm's points thus land where a KR 210 on the floor, or an arm
+mounted high on a torso lift, works.
+
+Frames: world, metres.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robocfg.checks.robot import CheckedRobot, load_robot
+from robocfg.checks.task import CheckedTask
+from robocfg.geometry import pose_matrix
+
+FK_SAMPLES = 400  # random configurations bounding how far the TCP can get from the arm base
+SCAN_STEPS = 24  # distances tried from that bound inwards
+REFINE_STEPS = 6  # bisection steps between the last reachable and the first unreachable distance
+IK_BUDGET = 0.2  # s per IK query (the iteration bound decides first)
+
+
+@dataclass(frozen=True)
+class PointMap:
+    """``p' = to + scale · (p − origin)`` (m, world), with the line saying so (``note``)."""
+
+    origin: np.ndarray
+    to: np.ndarray
+    scale: float
+    note: str
+
+    def point(self, p: Sequence[float]) -> list[float]:
+        return [float(v) for v in self.to + self.scale * (np.asarray(p, float) - self.origin)]
+
+    def length(self, x: float) -> float:
+        return float(self.scale * x)
+
+
+def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: str) -> PointMap | None:
+    """The map for ``poses`` (4x4 world_T_tcp targets written for the task's robot), or None when
+    the running robot's ``arm`` reaches every one, the file names the running robot itself, or no
+    reach can be measured (the run then reports the unreachable points itself)."""
+    ours_robot = task.robots[0]
+    ours = _model(task, ours_robot, arm)
+    if all(_reaches(ours, ours_robot, arm, T) for T in poses):
+        return None
+    written = task.written_robot
+    if written is None or written.resolve() == ours_robot.path.resolve():
+        return None
+    theirs_robot = load_robot(written)
+    theirs = _model(task, theirs_robot, None)
+    b_theirs, b_ours = _arm_base(theirs, theirs_robot, None), _arm_base(ours, ours_robot, arm)
+    middle = np.mean([T[:3, 3] for T in poses], axis=0)
+    direction = middle - b_theirs
+    if np.linalg.norm(direction) < 1e-6:
+        return None
+    direction /= np.linalg.norm(direction)
+    R = poses[0][:3, :3]
+    r_theirs = _reach(theirs, theirs_robot, None, b_theirs, direction, R)
+    r_ours = _reach(ours, ours_robot, arm, b_ours, direction, R)
+    if r_theirs <= 0.0 or r_ours <= 0.0:
+        return None
+    k = r_ours / r_theirs
+    note = (f"placement auto: {what} moved to {ours_robot.config.name}'s arm (reach {r_ours:.2f} m, the task's robot "
+            f"{theirs_robot.config.name}: {r_theirs:.2f} m): scaled x{k:.2f} about its base at "
+            f"[{b_ours[0]:.3f}, {b_ours[1]:.3f}, {b_ours[2]:.3f}] m")
+    return PointMap(b_theirs, b_ours, k, note)
+
+
+def _model(task: CheckedTask, robot: CheckedRobot, arm: str | None):
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.moves import bound_ik_by_iterations
+
+    model = KinematicModel.from_robot(robot, arm=robot.config.arm(arm).name, base_pose=pose_matrix(task.config.robots[0]))
+    bound_ik_by_iterations(model)  # same answers whatever the machine load
+    return model
+
+
+def _reaches(model, robot: CheckedRobot, arm: str | None, T: np.ndarray) -> bool:
+    home = np.asarray(robot.config.arm(arm).home, float)
+    return bool(model.ik(T, seed_q=home, frame="tcp", time_budget=IK_BUDGET).converged)
+
+
+def _arm_base(model, robot: CheckedRobot, arm: str | None) -> np.ndarray:
+    """World position (m) of the arm's base_link at its home pose."""
+    arm_cfg = robot.config.arm(arm)
+    return model.fk(np.asarray(arm_cfg.home, float), arm_cfg.base_link)[:3, 3].copy()
+
+
+def _reach(model, robot: CheckedRobot, arm: str | None, base: np.ndarray, direction: np.ndarray, R: np.ndarray) -> float:
+    """The farthest distance (m) from ``base`` along ``direction`` at which IK puts the TCP with
+    rotation ``R``; 0 when none of the distances tried is reached."""
+    rng = np.random.default_rng(0)
+    q = rng.uniform(model.lower, model.upper, size=(FK_SAMPLES, len(model.lower)))
+    far = max(float(np.linalg.norm(model.fk(qi, "tcp")[:3, 3] - base)) for qi in q)
+
+    def ok(d: float) -> bool:
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R, base + d * direction
+        return _reaches(model, robot, arm, T)
+
+    good, bad = None, far
+    for d in np.linspace(far, far / SCAN_STEPS, SCAN_STEPS):
+        if ok(float(d)):
+            good = float(d)
+            break
+        bad = float(d)
+    if good is None:
+        return 0.0
+    for _ in range(REFINE_STEPS):
+        mid = (good + bad) / 2
+        good, bad = (mid, bad) if ok(mid) else (good, mid)
+    return good
