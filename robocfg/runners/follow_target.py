@@ -126,7 +126,9 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
         tol = f"{params.reach_tolerance * 1000:.1f} mm / {math.degrees(params.orientation_tolerance):.2f} deg"
         e = result.position_error_mm
         at_rest = target.end_time <= params.duration - FINAL_WINDOW
-        moving = "" if e is None or at_rest else f"RMS {e.rms:.1f} mm after settling, "
+        o = result.orientation_error_deg
+        moving = ("" if e is None or at_rest else
+                  f"RMS {e.rms:.1f} mm" + ("" if o is None else f" / {o.rms:.2f} deg (max {o.max:.1f} deg)") + " after settling, ")
         msg = (f"target not reached within {tol}: {moving}residual {result.final_position_error_mm:.1f} mm / "
                f"{result.final_orientation_error_deg:.2f} deg ({result.unreachable_reason})")
         result.warnings.append(msg)
