@@ -10,8 +10,9 @@ for an object already lying in a scene full of others, with two changes:
   left out). Among the kept ones the choice is pick-place's (least joint travel);
 * **the place spot**: a bin spot is approached from ``lift_height`` above and left straight up; a
   shelf spot is entered ``place_clearance`` above its board (the planner finds the way in through
-  the open front), lowered onto, and left by lifting back to that height and withdrawing out of
-  the front (phase ``withdraw``), planned collision-free.
+  the open front), lowered onto (the hand goes on down until the board carries the object:
+  ``SET_DOWN_PRESS``), and left by lifting back to that height and withdrawing out of the front
+  (phase ``withdraw``), planned collision-free.
 
 :class:`ContactWatch` counts robot–fixture contacts in the simulation (every ``SETTLE_POLL``
 physics steps), the figure that must stay 0. Frames: world, 4×4, metres.
@@ -41,6 +42,12 @@ if TYPE_CHECKING:
 CARRIED_OFF = 0.01  # m: a released object that rises this much during the retract went with the fingers
 WITHDRAW_BEYOND = 0.12  # m: how far past a shelf's front edge the TCP withdraws
 FINGER_CLEARANCE = 0.025  # m: fingertips above a placed object's top before withdrawing: the planner's 1 cm margin, the 5 mm position tolerance, 1 cm spare
+# m: on a shelf board the hand goes this much further down than the object's lowest point needs to
+# touch the board before the fingers open, so the board carries the object. An object let go while
+# it hangs in the fingers (it slides a little in the grasp on the planned carry-in) can jam between
+# the opening finger hulls: on the Panda both fingers stalled at 2/3 open, still pressing on it, and
+# "did not come free" or rose with them on the retract.
+SET_DOWN_PRESS = 0.0015
 
 
 @dataclass(frozen=True)
@@ -204,6 +211,8 @@ class ObjectMachine(_StateMachine):
         self._free_move(T_above, check=self._dropped)
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
+        if shelf:
+            self._set_down()
         self.begin("release", "open the gripper")
         self.mover.max_acceleration = None
         self._release()
@@ -224,6 +233,15 @@ class ObjectMachine(_StateMachine):
         self.close_phase(True)
         self.mover.settle(0.3)
         self._check_placed()
+
+    def _set_down(self) -> None:
+        """Lower the hand (straight down, m) until the held object's lowest point is
+        ``SET_DOWN_PRESS`` into the spot's board, so that the board, not the fingers, carries it
+        when they open (see ``SET_DOWN_PRESS``)."""
+        pos, quat = self.world.body_pose(self.obj)
+        gap = float(pos[2]) - self.shape.below_origin(quat_to_matrix(quat)) - self.spot.z
+        down = max(0.0, gap) + SET_DOWN_PRESS
+        self.mover.move(_shifted(self.arm.ee_pose(), [0, 0, -down]), straight=True)
 
     def _carried_off(self, z_released: float) -> str | None:
         """Why the retract failed if the released object rose with the fingers (stuck to one)."""
