@@ -71,16 +71,25 @@ class EpisodeSession(ABC, Generic[RecordT]):
     """One world and everything episodes share; ``run(k)`` gives episode k's record."""
 
     phases: tuple[str, ...] = ()  # the kind's phase names, in order: a dataset's per-frame labels
+    # True: every episode after the first runs in a newly built world (built and prepared as for the
+    # first), not in the restored snapshot. For kinds whose episodes are not yet the same after a
+    # restore: Bullet's overlapping-pair order follows the bodies removed and re-added before, which
+    # moves objects standing close together by micrometres (clear_table). Costs one build per episode.
+    fresh_world_per_episode: bool = False
 
     def __init__(self, task: CheckedTask, options: RunOptions, timing: BatchTiming | None = None):
-        from robocfg.sim.world import World
-
         self.task, self.options = task, options
         self.seed = options.resolved_seed(task.config.sim.seed)
         self.timing = timing if timing is not None else BatchTiming()
         self._spawned: list[str] = []
         self._tap: EpisodeTap | None = None
-        self.world: World = World(task, gui=options.gui)
+        self._used = False  # an episode (or a replay) ran in the current world
+        self._build_world()
+
+    def _build_world(self) -> None:
+        from robocfg.sim.world import World
+
+        self.world: World = World(self.task, gui=self.options.gui)
         try:
             self.world.step(1)
             self.prepare()
@@ -145,7 +154,15 @@ class EpisodeSession(ABC, Generic[RecordT]):
             self._tap = sink.begin(self.world, arm, obj, phase_of, self.phases, language() if language else "")
 
     def _reset(self) -> None:
-        """Remove what the last episode spawned and restore the snapshot."""
+        """Remove what the last episode spawned and restore the snapshot (or, with
+        ``fresh_world_per_episode``, build a new world once one has been used)."""
+        if self.fresh_world_per_episode and self._used:
+            physics = self.world.physics_seconds
+            self.world.close()
+            self._spawned.clear()
+            self._build_world()
+            self.world.physics_seconds = physics  # the batch's physics time carries on
+        self._used = True
         w = self.world
         for name in self._spawned:
             if name in w.bodies:
@@ -160,9 +177,10 @@ class EpisodeSession(ABC, Generic[RecordT]):
 
     def run(self, k: int) -> RecordT:
         """Run episode ``k`` (any order, any number of times: the same record for the same k)."""
-        w = self.world
+        t0 = time.perf_counter()  # a fresh world's build counts in the episode's wall time
         self._reset()
-        t0, physics0 = time.perf_counter(), w.physics_seconds
+        w = self.world
+        physics0 = w.physics_seconds
         recorder = self._recorder(k)
         self._tap = None
         try:

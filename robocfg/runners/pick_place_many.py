@@ -78,7 +78,14 @@ def spot_points(task, params: PickPlaceManyParams) -> np.ndarray:
 
 
 class ManySession(EpisodeSession[ManyEpisode]):
-    """The world, kinematic model, planner, grasp filter and place spots every episode shares."""
+    """The world, kinematic model, planner, grasp filter and place spots every episode shares.
+
+    Each episode after the first gets a newly built world (``fresh_world_per_episode``): objects
+    standing close together (clear_table) ended micrometres apart after a restore, Bullet's pair
+    order following the objects removed before (``deterministicOverlappingPairs`` fixes that but
+    moves every result and jammed a shelf release, seed 0)."""
+
+    fresh_world_per_episode = True
 
     def prepare(self) -> None:
         from robocfg.assets.object_shape import object_shape
