@@ -20,6 +20,7 @@ Frames: world, metres.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,8 +34,6 @@ from robocfg.geometry import pose_matrix, quat_to_matrix
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
 
 FK_SAMPLES = 400  # random configurations bounding how far the tool can get from the base
-SCAN_STEPS = 24  # distances tried from that bound inwards
-REFINE_STEPS = 6  # bisection steps between the last reachable and the first unreachable distance
 IK_BUDGET = 0.2  # s per IK query (the iteration bound decides first)
 
 
@@ -47,6 +46,29 @@ class Placement:
     params: PickPlaceParams
     reach: list = field(default_factory=list)  # list[ReachProblem]
     note: str = ""
+
+
+SCAN_STEPS = 24  # distances tried from the far bound inwards
+REFINE_STEPS = 6  # bisection steps between the last reachable and the first unreachable distance
+
+
+def farthest_reachable(reachable: Callable[[float], bool], far: float) -> float:
+    """The largest distance ``d`` ≤ ``far`` (m) with ``reachable(d)``: scanned inwards from ``far``
+    in ``SCAN_STEPS`` steps, then bisected ``REFINE_STEPS`` times towards the first unreachable
+    distance beyond it; 0.0 when none is reachable. Scanning from outside in finds the outermost
+    reachable distance even where nearer ones are unreachable (close to the base)."""
+    good, bad = None, far
+    for d in np.linspace(far, far / SCAN_STEPS, SCAN_STEPS):
+        if reachable(float(d)):
+            good = float(d)
+            break
+        bad = float(d)
+    if good is None:
+        return 0.0
+    for _ in range(REFINE_STEPS):
+        mid = (good + bad) / 2
+        good, bad = (mid, bad) if reachable(mid) else (good, mid)
+    return good
 
 
 def resolved_params(task: CheckedTask, arm: str | None = None) -> PickPlaceParams:
@@ -168,15 +190,4 @@ def arm_reach(task: CheckedTask, arm: str | None = None, robot: CheckedRobot | N
                 return False
         return True
 
-    good, bad = None, far
-    for d in np.linspace(far, far / SCAN_STEPS, SCAN_STEPS):
-        if reachable(float(d)):
-            good = float(d)
-            break
-        bad = float(d)
-    if good is None:
-        return 0.0
-    for _ in range(REFINE_STEPS):
-        mid = (good + bad) / 2
-        good, bad = (mid, bad) if reachable(mid) else (good, mid)
-    return good
+    return farthest_reachable(reachable, far)

@@ -24,10 +24,9 @@ import numpy as np
 from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.task import CheckedTask
 from robocfg.geometry import pose_matrix
+from robocfg.motion.placement import farthest_reachable
 
 FK_SAMPLES = 400  # random configurations bounding how far the TCP can get from the arm base
-SCAN_STEPS = 24  # distances tried from that bound inwards
-REFINE_STEPS = 6  # bisection steps between the last reachable and the first unreachable distance
 IK_BUDGET = 0.2  # s per IK query (the iteration bound decides first)
 
 
@@ -110,15 +109,4 @@ def _reach(model, robot: CheckedRobot, arm: str | None, base: np.ndarray, direct
         T[:3, :3], T[:3, 3] = R, base + d * direction
         return _reaches(model, robot, arm, T)
 
-    good, bad = None, far
-    for d in np.linspace(far, far / SCAN_STEPS, SCAN_STEPS):
-        if ok(float(d)):
-            good = float(d)
-            break
-        bad = float(d)
-    if good is None:
-        return 0.0
-    for _ in range(REFINE_STEPS):
-        mid = (good + bad) / 2
-        good, bad = (mid, bad) if ok(mid) else (good, mid)
-    return good
+    return farthest_reachable(ok, far)
