@@ -98,7 +98,7 @@ class KinematicModel:
         full = pin.buildModelFromXML(xml)
         arm_joints = robot.arm_joints(arm_cfg)
 
-        locked = _locked_values(robot, arm_cfg.name, gripper_q or {})
+        locked = locked_joint_values(robot, arm_cfg.name, gripper_q or {})
         q_full = pin.neutral(full)
         lock_ids = []
         for jid in range(1, full.njoints):
@@ -272,9 +272,10 @@ def _frame_id(model: pin.Model, name: str) -> int:
     raise NotFound("frame", name, ["ee", *known])
 
 
-def _locked_values(robot: CheckedRobot, arm_name: str, overrides: dict[str, float]) -> dict[str, float]:
-    """Values of the locked joints: the robot's ``locked_joints``, grippers open, other arms at home,
-    mimic followers following."""
+def locked_joint_values(robot: CheckedRobot, arm_name: str, overrides: dict[str, float]) -> dict[str, float]:
+    """Values (rad or m) of every DOF that arm ``arm_name`` does not move: the robot's
+    ``locked_joints``, grippers open, other arms at home, ``overrides``, mimic followers following.
+    The one source of these values for the kinematic model and the reactive controller."""
     from robocfg.config.robot import ParallelGripperConfig
 
     values: dict[str, float] = dict(robot.config.locked_joints)

@@ -12,7 +12,6 @@ import numpy as np
 
 from robocfg.collision import EnvShape, robot_geometry
 from robocfg.config.commands import FollowObstacle
-from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body, Scene
 from robocfg.config.types import AXIS_INDEX
 from robocfg.geometry import pose_matrix
@@ -30,7 +29,10 @@ def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: s
     """``ArmSpec`` for ``arm`` of a ``CheckedRobot``: URDF limits (``drives`` overrides; continuous
     joints unbounded), TCP from
     ``tcp_offset``/``ee_axis``, posture = home; non-arm joints held at ``other_joints`` (default:
-    gripper open, mimic followers following, anything else 0)."""
+    as the kinematic model holds them, ``locked_joint_values``: the robot's ``locked_joints`` (a
+    torso lift), other arms at home, grippers open, mimic followers following)."""
+    from robocfg.kinematics.model import locked_joint_values
+
     cfg = robot.config
     arm_cfg = cfg.arm(arm)
     names = robot.arm_joints(arm_cfg)
@@ -39,13 +41,8 @@ def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: s
     acc = np.array([cfg.drives.acceleration_limits.get(n, acceleration) for n in names])
     T_ee_tcp = np.eye(4)
     T_ee_tcp[AXIS_INDEX[arm_cfg.ee_axis], 3] = arm_cfg.tcp_offset
-    held = dict(other_joints or {})
-    if other_joints is None and isinstance(arm_cfg.gripper, ParallelGripperConfig):
-        leaders = robot.gripper_joints(arm_cfg)
-        held.update(zip(leaders, arm_cfg.gripper.open, strict=True))
-        for j in urdf.joints.values():
-            if j.mimic is not None and j.mimic.joint in held:
-                held[j.name] = j.mimic.multiplier * held[j.mimic.joint] + j.mimic.offset
+    held = dict(other_joints) if other_joints is not None else locked_joint_values(robot, arm_cfg.name, {})
+    held = {j: v for j, v in held.items() if j not in names and j in urdf.joints}
     collision, _ = robot_geometry(robot)
     return ArmSpec(
         urdf_path=Path(urdf_path), joint_names=names, ee_link=arm_cfg.ee_link, T_ee_tcp=T_ee_tcp,
