@@ -215,3 +215,40 @@ def test_a_clear_table_episode_gives_the_same_record_alone_or_after_another():
     with open_session(task, RunOptions(seed=0)) as session:
         alone = session.run(1)
     assert after.success and after == alone
+
+
+def test_contact_watch_counts_touching_points_not_the_near_ones_pybullet_also_reports():
+    """PyBullet's ``getContactPoints`` also returns points still apart (positive distance): the
+    watch counts only polls with a point at distance ≤ 0, by phase and link, and keeps the
+    closest distance. A static box is raised in 0.25 mm steps under the Panda's forearm
+    (``panda_link5``) from 5 mm below its bounding box to 5 mm into it, one poll per step."""
+    from robocfg.config.scene import Body
+    from robocfg.runners.pick_place_many_machine import SETTLE_POLL, ContactWatch
+    from robocfg.sim.world import World
+
+    world = World(load_task(catalog.find("tasks", "pick_place_shelf")))
+    try:
+        world.step(1)
+        robot = world.robot
+        lo, hi = world.aabb(robot.body_id, robot.link("panda_link5"))
+        x, y = (lo[:2] + hi[:2]) / 2
+        world.add_body(Body(name="probe", shape="box", size=[0.1, 0.1, 0.02], position=[x, y, lo[2] - 0.1],
+                            mass=0.0), static=True)
+        watch = ContactWatch(world, ["probe"], lambda: "lower")
+        seen: list[tuple[float | None, int]] = []  # (closest reported distance, polls counted so far)
+        for top in np.arange(-0.005, 0.00501, 0.00025):
+            world.set_body_pose("probe", [x, y, lo[2] + top - 0.01])
+            for _ in range(SETTLE_POLL):
+                world.step(1)
+                watch.on_step()
+            pts = world.contact_points(robot.body_id, "probe")
+            seen.append((min((p.distance for p in pts), default=None), watch.count))
+        counted = [c1 - c0 for (_, c0), (_, c1) in zip([(None, 0), *seen], seen, strict=False)]
+        for (d, _), c in zip(seen, counted, strict=True):
+            assert c == (1 if d is not None and d <= 0 else 0), (d, c)
+        assert any(d is not None and d > 0 for d, _ in seen)  # PyBullet did report points still apart
+        assert watch.count == sum(d is not None and d <= 0 for d, _ in seen) > 0
+        assert watch.first == "lower: panda_link5 touched probe" and watch.by_kind == {watch.first: watch.count}
+        assert watch.closest == pytest.approx(min(d for d, _ in seen if d is not None))
+    finally:
+        world.close()

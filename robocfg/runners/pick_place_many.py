@@ -161,7 +161,9 @@ class ManySession(EpisodeSession[ManyEpisode]):
             failed_object=failure[0] if failure else None,
             reason=f"{failure[0]}: {failure[2]}" if failure else f"{len(order)} objects placed",
             placed=sum(r.success for r in records), order=order, robot_fixture_contacts=watch.count,
-            first_contact=watch.first, sim_time=round(self.world.t, 6), steps=self.world.steps, objects=records)
+            first_contact=watch.first, sim_time=round(self.world.t, 6), steps=self.world.steps, objects=records,
+            contacts_by_kind=dict(sorted(watch.by_kind.items())),
+            closest_fixture=None if watch.closest is None else round(watch.closest, 6))
 
     def _next(self, machines: dict[str, ObjectMachine], remaining: list[str]) -> str:
         """The next object: the first listed, or (reachability) the one whose collision-free grasp

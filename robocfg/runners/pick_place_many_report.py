@@ -39,7 +39,10 @@ class ManyEpisode:
     """One episode: ``success`` when every object was placed. A failure names the object
     (``failed_object``) and the phase; ``reason`` starts with the object's name.
     ``robot_fixture_contacts``: polls (every 4 physics steps) at which the robot touched a fixture
-    part or an obstacle; ``first_contact`` names the first (phase, link, part)."""
+    part or an obstacle; ``first_contact`` names the first (phase, link, part);
+    ``contacts_by_kind`` counts the polls per ``"phase: link touched part"``. A contact is a point
+    PyBullet reports at distance ≤ 0; ``closest_fixture`` is the smallest robot–fixture distance
+    PyBullet reported at a poll (m; it reports pairs up to a few mm apart; None: none that close)."""
 
     index: int
     seed: int
@@ -54,6 +57,8 @@ class ManyEpisode:
     sim_time: float  # s
     steps: int
     objects: list[ObjectRecord] = field(default_factory=list)
+    contacts_by_kind: dict[str, int] = field(default_factory=dict)
+    closest_fixture: float | None = None
 
 
 @dataclass
@@ -68,6 +73,8 @@ class ManySummary:
     robot_fixture_contacts: int
     episodes_with_contact: int
     mean_sim_time: float
+    contacts_by_kind: dict[str, int] = field(default_factory=dict)  # polls per "phase: link touched part"
+    closest_fixture: float | None = None  # m: the smallest robot–fixture distance PyBullet reported
 
 
 def summarise(episodes: list[ManyEpisode]) -> ManySummary:
@@ -75,7 +82,10 @@ def summarise(episodes: list[ManyEpisode]) -> ManySummary:
     ok = sum(e.success for e in episodes)
     by_phase: dict[str, int] = {}
     by_object: dict[str, int] = {}
+    by_kind: dict[str, int] = {}
     for e in episodes:
+        for kind, c in e.contacts_by_kind.items():
+            by_kind[kind] = by_kind.get(kind, 0) + c
         if not e.success:
             by_phase[e.failed_phase or "?"] = by_phase.get(e.failed_phase or "?", 0) + 1
             by_object[e.failed_object or "?"] = by_object.get(e.failed_object or "?", 0) + 1
@@ -83,7 +93,8 @@ def summarise(episodes: list[ManyEpisode]) -> ManySummary:
                        sum(len(e.objects) for e in episodes), by_phase, by_object,
                        sum(e.robot_fixture_contacts for e in episodes),
                        sum(e.robot_fixture_contacts > 0 for e in episodes),
-                       sum(e.sim_time for e in episodes) / n if n else 0.0)
+                       sum(e.sim_time for e in episodes) / n if n else 0.0, dict(sorted(by_kind.items())),
+                       min((e.closest_fixture for e in episodes if e.closest_fixture is not None), default=None))
 
 
 @dataclass
@@ -115,6 +126,10 @@ class ManyReport(EpisodesReport):
                 ("failures by object", ", ".join(f"{k}: {v}" for k, v in s.failures_by_object.items()) or "none"),
                 ("robot-fixture contacts", f"{s.robot_fixture_contacts} (in {s.episodes_with_contact} episodes)"),
                 ("simulated time / episode", f"{s.mean_sim_time:.2f} s")]
+        if s.closest_fixture is not None:
+            rows.insert(6, ("closest robot-fixture distance", f"{s.closest_fixture * 1000:.1f} mm"))
+        if s.contacts_by_kind:
+            rows.insert(6, ("contacts by phase and link", ", ".join(f"{k} ×{v}" for k, v in s.contacts_by_kind.items())))
         if timing is not None:
             rows.append(("wall time / episode", f"{timing.mean_episode:.3f} s (total {timing.wall_time:.1f} s)"))
         footer = [failed_episodes_line([str(e.index) for e in failed])] if failed else []
