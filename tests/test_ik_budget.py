@@ -102,3 +102,36 @@ def test_a_backend_added_as_the_architecture_recipe_says(model: KinematicModel) 
         assert res.converged and res.backend == GaussNewton.name and res.iterations <= 200
     finally:
         registry._REGISTRY.pop(GaussNewton.name, None)
+
+
+class _LoadedClock:
+    """A clock on a machine so loaded that a second passes between any two readings."""
+
+    def __init__(self) -> None:
+        self.t = 0.0
+
+    def __call__(self) -> float:
+        self.t += 1.0
+        return self.t
+
+
+@pytest.mark.parametrize("backend", ["lm", "pink", "placo"])
+def test_with_an_iteration_budget_the_clock_ends_no_search(model: KinematicModel, backend: str) -> None:
+    """Machine load must not change an answer: with ``max_total_iter`` set, a clock that jumps a
+    second per reading (far past the 0.2 s budget) gives the same answer as the real clock."""
+    solver = model.solver(backend)
+    target = model.fk(model.mid, "ee")
+    target[:3, 3] += [3.0, 0.0, 0.0]  # unreachable: only the budget ends the search
+    reachable = model.fk(model.mid + 0.3, "ee")
+    solver.max_total_iter = BUDGET
+    try:
+        quiet = [model.ik(T, model.mid, frame="ee", backend=backend, time_budget=0.2) for T in (target, reachable)]
+        solver.clock = _LoadedClock()
+        loaded = [model.ik(T, model.mid, frame="ee", backend=backend, time_budget=0.2) for T in (target, reachable)]
+    finally:
+        solver.max_total_iter = None
+        del solver.clock  # back to the class's clock
+    for a, b in zip(quiet, loaded, strict=True):
+        assert a.iterations == b.iterations and a.restarts == b.restarts
+        assert np.array_equal(a.q, b.q)
+    assert loaded[0].iterations == BUDGET and loaded[0].restarts >= 1

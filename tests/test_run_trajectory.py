@@ -142,3 +142,18 @@ def test_unreachable_waypoint_fails_with_a_report_naming_the_phase(tmp_path, cap
     assert report["success"] is False and report["kind"] == "trajectory" and report["robot"] == "panda"
     assert report["phase"] == "waypoints" and "unreachable" in report["reason"]
     assert report["schema_version"] >= 2
+
+
+def test_cartesian_waypoint_ik_does_not_depend_on_machine_load(tmp_path, monkeypatch):
+    """The waypoints' IK is bounded by iterations, not by the wall clock: with a clock that jumps a
+    second per reading (a heavily loaded machine) the plan is the same."""
+    from robocfg.checks.task import load_task
+    from robocfg.kinematics.ik.lm import LMSolver
+    from robocfg.runners.trajectory import plan_task
+
+    task = load_task(ROOT / "robocfg" / "data" / "tasks" / "trajectory.yaml")
+    quiet = plan_task(task)[-1].waypoints
+    ticks = iter(range(1, 10**9))
+    monkeypatch.setattr(LMSolver, "clock", staticmethod(lambda: float(next(ticks))))
+    loaded = plan_task(task)[-1].waypoints
+    assert np.array_equal(quiet, loaded)

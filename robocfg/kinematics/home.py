@@ -20,7 +20,11 @@ from robocfg.kinematics.model import KinematicModel
 REACH_SAMPLES = 400
 DISTANCES = (0.5, 0.4, 0.6, 0.3)  # fractions of the reach, in front of the base
 HEIGHTS = (0.3, 0.2, 0.4, 0.1)  # fractions of the reach, above the first joint's origin
-IK_BUDGET = 0.2  # s per IK call
+IK_BUDGET = 0.2  # s per IK call: not consulted while IK_ITERATIONS bounds the search
+# LM iterations per IK call over all restarts: the search ends by count, not by the clock, so a
+# draft's home is the same on a loaded machine (a converging target takes < 10; a failing one ran
+# 840-2260 in 0.2 s on a quiet 2-core machine)
+IK_ITERATIONS = 1000
 LIMIT_MARGIN = 0.16  # rad: a home this far inside every limit leaves room for 3 × the draft's home_std (0.05)
 
 
@@ -36,7 +40,15 @@ def reach(model: KinematicModel, rng: np.random.Generator) -> tuple[float, float
 def find_home(model: KinematicModel, seed: int = 0) -> np.ndarray | None:
     """Joint values (arm order) with the tool pointing down over the workspace, or None when no
     target in front of the robot is reachable with the tool down."""
-    rng = np.random.default_rng(seed)
+    solver = model.solver()
+    cap, solver.max_total_iter = solver.max_total_iter, IK_ITERATIONS
+    try:
+        return _find_home(model, np.random.default_rng(seed))
+    finally:
+        solver.max_total_iter = cap
+
+
+def _find_home(model: KinematicModel, rng: np.random.Generator) -> np.ndarray | None:
     r, z0 = reach(model, rng)
     arm = model.robot.config.arm() if model.robot is not None else None
     if arm is None:

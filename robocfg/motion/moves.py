@@ -9,7 +9,8 @@ follow-target controller that avoids the scene, with the same checks). Failures 
 ``MoveFailed(phase, reason)``. Poses are world_T_ee (4x4, m).
 
 IK is bounded by an iteration budget (``bound_ik_by_iterations``) rather than wall-clock time, so
-the same seed gives the same answers whatever the machine load; ``ik_budget`` (s) is a safety net.
+the same seed gives the same answers whatever the machine load; ``ik_budget`` (s) bounds a model
+that has no iteration budget only.
 """
 
 from __future__ import annotations
@@ -45,9 +46,9 @@ IK_ITERATIONS = 400  # LM iterations per IK query over all restarts (see bound_i
 
 
 def bound_ik_by_iterations(model: KinematicModel, iterations: int = IK_ITERATIONS) -> None:
-    """Make ``model``'s IK solver stop after ``iterations`` iterations (all restarts included)
-    instead of when its time budget runs out: every backend honours the budget, so the answers
-    do not depend on the machine's speed or load."""
+    """Make ``model``'s IK solver stop after ``iterations`` iterations (all restarts included),
+    never by its time budget (which it then ignores): every backend honours the budget, so the
+    answers do not depend on the machine's speed or load."""
     model.solver().max_total_iter = iterations
 
 
@@ -82,7 +83,7 @@ class ArmMover:
     timeout: float | None = 4.0
     on_step: Callable[[], None] | None = None
     phase: str = "move"
-    ik_budget: float = 1.0  # s of wall clock per IK query: a safety net (bound_ik_by_iterations binds)
+    ik_budget: float = 1.0  # s of wall clock per IK query, for a model without bound_ik_by_iterations
     max_acceleration: float | None = None  # m/s²: the EE's peak acceleration in a timed move (a held load), None: free
 
     def solve(self, T: np.ndarray, seed: np.ndarray, what: str = "") -> np.ndarray:

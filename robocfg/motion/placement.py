@@ -34,7 +34,7 @@ from robocfg.geometry import pose_matrix, quat_to_matrix
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
 
 FK_SAMPLES = 400  # random configurations bounding how far the tool can get from the base
-IK_BUDGET = 0.2  # s per IK query (the iteration bound decides first)
+IK_BUDGET = 0.2  # s per IK query; not consulted: bound_ik_by_iterations ends the search by count
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ from robocfg.geometry import pose_matrix, quat_to_matrix
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
 
 YAW_STEPS = 6  # tool turns about the vertical tried over half a turn
-IK_BUDGET = 0.2  # s of wall clock per IK query (the iteration bound decides first)
+IK_BUDGET = 0.2  # s of wall clock per IK query; not consulted: bound_ik_by_iterations ends the search by count
 WORLD_HINT = ("the spots are world coordinates: give them relative to the arm with 'placement: reach' "
               "(as the built-in task pick_place_reach does)")
 

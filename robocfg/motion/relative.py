@@ -27,7 +27,7 @@ from robocfg.geometry import pose_matrix
 from robocfg.motion.placement import farthest_reachable
 
 FK_SAMPLES = 400  # random configurations bounding how far the TCP can get from the arm base
-IK_BUDGET = 0.2  # s per IK query (the iteration bound decides first)
+IK_BUDGET = 0.2  # s per IK query; not consulted: bound_ik_by_iterations ends the search by count
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ path is timed with a stop at every waypoint instead (straight segments: exactly 
 
 The budget is given in milliseconds and enforced as a number of collision checks (``budget_ms`` ×
 ``checks_per_ms``), so a search ends at the same point on a loaded or an idle machine and the same
-query gives the same answer; ``budget_ms`` × ``wall_factor`` of wall clock is a safety net.
+query gives the same answer (``wall_factor`` is kept for settings files; the wall clock ends no search).
 Joint values in rad (arm order), lengths in rad (Euclidean joint space).
 """
 

@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 
 Log = Callable[[str], None]
 SPAWN_SETTLE = 0.6  # s the object is left to come to rest before perception
-REACH_IK_BUDGET = 0.5  # s per IK call while ranking candidates: a safety net; the iteration bound binds
+REACH_IK_BUDGET = 0.5  # s per IK call while ranking candidates; not consulted: the iteration bound ends the search
 MAX_APPROACH_JUMP = 1.0  # rad: pre-grasp and grasp IK answers further apart are not one straight approach
 FAILED_NEAR = 0.015  # m: candidates this close to a failed grasp (same object pose) are skipped
 HALF_TURN = np.diag([1.0, -1.0, -1.0])  # about the approach axis: the same parallel-jaw grasp

@@ -138,9 +138,11 @@ def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
         return None
     from robocfg.geometry import pose_to_matrix
     from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.moves import bound_ik_by_iterations
 
     mount = task.config.robots[0]
     model = KinematicModel.from_robot(task.robots[0], arm_name, base_pose=pose_to_matrix(mount.position, mount.quaternion_xyzw()))
+    bound_ik_by_iterations(model)  # same waypoints ⇒ same joint values, whatever the machine load
     return lambda target, seed: model.ik(target, seed_q=seed, frame="tcp")
 
 

@@ -106,12 +106,16 @@ def search(km: KinematicModel, descend: Descend, q0: np.ndarray, deadline: float
     converges, the deadline passes or ``max_total_iter`` iterations have been spent (``cap``: the
     iterations left, None: no cap). ``rng`` None: ``default_rng(0)``.
 
-    ``deadline`` is on ``clock`` (default ``time.perf_counter``).
+    ``deadline`` is on ``clock`` (default ``time.perf_counter``). With ``max_total_iter`` set the
+    deadline is not consulted (``descend`` gets ``inf``): the iteration count alone ends the
+    search, so the answer is the same on a loaded machine as on a quiet one.
     Returns (best q by score, total iterations, restarts).
     """
     from time import perf_counter
 
     clock = clock or perf_counter
+    if max_total_iter is not None:
+        deadline = math.inf
     best_s, best_q = math.inf, q0
     iters = restarts = 0
     q = q0

@@ -8,7 +8,9 @@ Two budgets bound a query. ``time_budget`` (s, on ``clock``) is what the IK benc
 with. ``max_total_iter`` counts iterations over the first descent and every restart together;
 when it is set, the answer depends only on the inputs and the ``rng`` (not on the machine or its
 load), which is how episode runners get the same JSON for the same seed. Every backend must
-honour it; the time budget then only serves as a safety net.
+honour it, and then ignore ``time_budget``: a wall-clock "safety net" would still end a search
+early on a loaded machine (a process descheduled for 0.2 s) and change the answer
+(``robocfg.kinematics.ik.common.search`` does this for the backends built on it).
 """
 
 from __future__ import annotations
