@@ -188,3 +188,32 @@ def test_a_goal_past_a_full_turn_is_brought_next_to_the_start_and_reached():
     lo, hi = planner.search_box(qs, near)
     assert np.all(lo >= kin.lower) and np.all(hi <= kin.upper)
     assert hi[5] - lo[5] == pytest.approx(0.2 + 2 * np.pi)  # [min − π, max + π] for a ±2π joint
+
+
+def test_goal_prefers_an_ik_answer_whose_straight_line_after_it_is_continuous(panda):
+    """A top-down pre-grasp pose whose nearest IK answer (from this start) has the wrist past
+    2.9 rad: going 13 cm straight down from it, a joint jumps (a branch is crossed). With the line
+    given, the drive's goal is another answer of the same pose, collision-free, from which the
+    line is continuous; without it, the nearest answer as before."""
+    from robocfg.motion.moves import ArmMover, MoveFailed, bound_ik_by_iterations
+    from robocfg.planning.drive import PlannedDrive
+
+    _, kin, links = panda
+    bound_ik_by_iterations(kin)
+    checker = CollisionChecker(kin, links, [GROUND])
+    drive = PlannedDrive(JointPlanner(checker, kin.lower, kin.upper), kin, kin.ee_link, [])
+    mover = ArmMover(None, None, kin, None)  # type: ignore[arg-type]  # IK only: no world
+    c, s = np.cos(-2.618), np.sin(-2.618)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]) @ DOWN, [0.5, -0.3, 0.25]
+    T_down = T.copy()
+    T_down[2, 3] = 0.12
+    q0 = np.array([1.363, -1.189, 2.155, -1.441, -1.189, 1.565, -2.799])
+    nearest = mover.solve(T, q0)
+    with pytest.raises(MoveFailed, match="no continuous IK along the straight line"):
+        mover.straight_waypoints(nearest, T_down)
+    assert np.allclose(drive.goal(mover, T, q0), nearest)
+    q = drive.goal(mover, T, q0, lines=[T_down])
+    assert checker.is_valid(q) and np.allclose(kin.fk(q, "ee"), T, atol=1e-3)
+    W = mover.straight_waypoints(q, T_down)
+    assert np.allclose(kin.fk(W[-1], "ee"), T_down, atol=1e-3)

@@ -75,32 +75,60 @@ class PlannedDrive:
                 pos, quat = world.body_pose(name)
                 self.checker.move_shape(name, pose_to_matrix(pos, quat))
 
-    def goal(self, mover: ArmMover, T_goal: np.ndarray, q0: np.ndarray) -> np.ndarray:
+    def goal(self, mover: ArmMover, T_goal: np.ndarray, q0: np.ndarray,
+             lines: Sequence[np.ndarray] = ()) -> np.ndarray:
         """A collision-free IK answer for ``T_goal`` (EE, world): the one nearest ``q0`` if it is
-        free, else the free answer with the least joint travel among seeded restarts."""
+        free, else the free answer with the least joint travel among seeded restarts.
+
+        ``lines``: EE poses the arm goes on to in straight lines from ``T_goal``, one after the
+        other (a pick's approach and lift, a place's lowering). An answer from which IK along them
+        is not continuous (a wrist or shoulder branch crossed, e.g. a joint at its limit half-way
+        down: ``ArmMover.straight_waypoints``) would fail there; a free answer whose lines are
+        continuous is preferred, among the same restarts. When none is, the nearest free answer
+        is returned and the line fails with its own reason."""
         q = mover.solve(T_goal, q0)
-        if self.checker.is_valid(q):
+        if self.checker.is_valid(q) and self.lines_continuous(mover, q, lines):
             return q
         rng = np.random.default_rng([len(q0), 0x1C])
-        best, travel = None, np.inf
+        best, travel, fallback = None, np.inf, q if self.checker.is_valid(q) else None
+        fallback_travel = 0.0 if fallback is not None else np.inf
         for _ in range(GOAL_IK_RESTARTS):
             seed = rng.uniform(self.kin.lower, self.kin.upper)
             res = self.kin.ik(T_goal, seed_q=seed, frame="ee", time_budget=mover.ik_budget, rng=rng)
             if res.converged and self.checker.is_valid(res.q):
                 d = float(np.max(np.abs(res.q - q0)))
-                if d < travel:
+                if d < travel and self.lines_continuous(mover, res.q, lines):
                     best, travel = res.q, d
+                elif d < fallback_travel:
+                    fallback, fallback_travel = res.q, d
+        if best is None:
+            best = fallback
         if best is None:  # every answer collides: name what the nearest one hits
             hits = ", ".join(c.describe() for c in self.checker.contacts(q)[:3])
             raise PhaseFailed(mover.phase, f"the goal configuration is in collision ({hits}, "
                                            f"margin {self.checker.margin * 1000:.0f} mm)")
         return best
 
-    def move(self, mover: ArmMover, T_goal: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
-        """Move ``mover``'s arm to ``T_goal`` (EE, world) along a planned collision-free path."""
+    @staticmethod
+    def lines_continuous(mover: ArmMover, q: np.ndarray, lines: Sequence[np.ndarray]) -> bool:
+        """Whether IK is continuous along the straight EE lines from FK(``q``) through ``lines``."""
+        from robocfg.motion.moves import MoveFailed
+
+        for T in lines:
+            try:
+                q = mover.straight_waypoints(q, T)[-1]
+            except MoveFailed:
+                return False
+        return True
+
+    def move(self, mover: ArmMover, T_goal: np.ndarray, check: Callable[[], str | None] | None = None,
+             lines: Sequence[np.ndarray] = ()) -> None:
+        """Move ``mover``'s arm to ``T_goal`` (EE, world) along a planned collision-free path, to a
+        configuration from which the straight ``lines`` that follow have continuous IK if one
+        is found (:meth:`goal`)."""
         self.refresh_loose(mover.world)
         q0 = mover.arm.joint_positions()
-        q_goal = self.goal(mover, T_goal, q0)
+        q_goal = self.goal(mover, T_goal, q0, lines)
         try:
             path = self.planner.plan(q0, q_goal)
         except PlanningFailed as exc:

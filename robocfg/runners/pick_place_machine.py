@@ -13,7 +13,7 @@ friction only (parallel grippers) or by the suction cup. A phase that cannot com
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -92,7 +92,7 @@ class _StateMachine(GraspChoice):
         if self.planned is not None:
             self._attach_held()
         self.begin("transport", "carry above the place point")
-        self._free_move(T_above_place, check=self._dropped)
+        self._free_move(T_above_place, check=self._dropped, lines=(T_place,))
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
         self.begin("release", "open the gripper")
@@ -113,7 +113,8 @@ class _StateMachine(GraspChoice):
         T_grasp = ee_pose_from_grasp(grasp, self.cfg)
         T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
         self.begin("pre_grasp", "move above the object")
-        self._free_move(T_pre)
+        T_lift = shifted(T_grasp, [0, 0, p.lift_height])
+        self._free_move(T_pre, lines=(T_grasp, T_lift))
         self.begin("approach", "down to grasp height")
         self.mover.move(T_grasp, straight=True)
         self.begin("grasp", "close the gripper")
@@ -121,7 +122,6 @@ class _StateMachine(GraspChoice):
         self._limit_acceleration()
         self.begin("lift", f"lift {p.lift_height * 100:.0f} cm")
         z0 = self.world.body_pose(self.obj)[0][2]
-        T_lift = shifted(T_grasp, [0, 0, p.lift_height])
         self.mover.move(T_lift, straight=True)
         self._verify_lift(z0)
         return T_lift
@@ -144,10 +144,13 @@ class _StateMachine(GraspChoice):
         self._phase = None
 
     # ---- motion ------------------------------------------------------------------------------
-    def _free_move(self, T: np.ndarray, check: Callable[[], str | None] | None = None) -> None:
-        """A free-space move (pre-grasp, transport): joint-space trajectory or reactive controller."""
+    def _free_move(self, T: np.ndarray, check: Callable[[], str | None] | None = None,
+                   lines: Sequence[np.ndarray] = ()) -> None:
+        """A free-space move (pre-grasp, transport): joint-space trajectory or reactive controller.
+        ``lines``: the EE poses the straight moves after it go to (planned mode: a goal
+        configuration from which they have continuous IK is preferred)."""
         if self.planned is not None:
-            self.planned.move(self.mover, T, check=check)
+            self.planned.move(self.mover, T, check=check, lines=lines)
         elif self.reactive is None:
             self.mover.move(T, straight=False, check=check)
         else:

@@ -228,7 +228,7 @@ class ObjectMachine(_StateMachine):
         if self.planned is not None:
             self._attach_held()
         self.begin("transport", "carry above the place spot")
-        self._free_move(T_above, check=self._dropped)
+        self._free_move(T_above, check=self._dropped, lines=(T_place,))
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
         if shelf:
