@@ -31,3 +31,50 @@ def test_controller_model_holds_the_locked_lift_and_the_other_arm(arm):
     model = KinematicModel.from_robot(robot, arm=arm)
     expected = model.fk(home, "tcp")
     assert np.linalg.norm(ctrl.tcp_pose(home)[:3, 3] - expected[:3, 3]) < 1e-6
+
+
+def test_moving_target_is_tracked_at_the_same_instant_not_a_step_ahead():
+    """Panda on the default circle (0.157 m/s): the TCP is where the target is, not ahead of it.
+    It led by two control steps (1.1 mm RMS): the controller's error compared the pose now with
+    the target one step later while feeding its velocity forward, and the drives were sent the
+    step's end position with its velocity, which PyBullet's motor law turns into one more step of
+    lead (``drive_target``)."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.runners.follow_target import run_follow_target
+
+    task = load_task(catalog.find("tasks", "follow_target"), overrides={"follow_target.duration": 2.5})
+    res = run_follow_target(task)
+    assert res.reached and res.position_error_mm is not None
+    assert res.position_error_mm.rms < 0.5  # two steps of lead: 2 × 0.157 m/s × 1/240 s = 1.3 mm
+
+
+def test_drive_target_keeps_a_pybullet_joint_on_its_ramp():
+    """One revolute joint driven along a ramp with ``drive_target``: it stays on the ramp (with the
+    ramp's end as the target it runs one physics step ahead)."""
+    import pybullet as p
+    import pybullet_data
+
+    from robocfg.runners.follow_target_loop import drive_target
+
+    speed, h = 0.5, 1.0 / 240.0
+    for n_sub, ahead in ((1, False), (1, True), (4, False)):
+        cid = p.connect(p.DIRECT)
+        try:
+            body = p.loadURDF(pybullet_data.getDataPath() + "/kuka_iiwa/model.urdf", useFixedBase=True, physicsClientId=cid)
+            q_end = 0.0
+            worst = 0.0
+            for _ in range(60):
+                q_end += speed * h * n_sub
+                target = q_end if ahead else drive_target(np.array([q_end]), np.array([speed]), h * n_sub, n_sub)[0]
+                p.setJointMotorControl2(body, 0, p.POSITION_CONTROL, targetPosition=float(target), targetVelocity=speed,
+                                        positionGain=0.1, velocityGain=1.0, force=300.0, physicsClientId=cid)
+                for _ in range(n_sub):
+                    p.stepSimulation(physicsClientId=cid)
+                worst = max(worst, abs(p.getJointState(body, 0, physicsClientId=cid)[0] - q_end))
+        finally:
+            p.disconnect(cid)
+            if ahead:
+                assert worst > 0.9 * speed * h  # one physics step ahead
+            else:
+                assert worst < 0.1 * speed * h * n_sub

@@ -132,13 +132,13 @@ class FollowLoop:
                 except GUI_ERROR:  # the GUI window was closed
                     r.warnings.append(f"GUI closed at t = {w.t:.2f} s: run stopped")
                     break
-                T_goal, v_goal = _goal(self.target, t + self.ctrl_dt, dragged)
+                T_goal, v_goal = _goal(self.target, t, dragged)  # now: the controller steps to t + ctrl_dt
                 res = self.ctrl.step(T_goal, q_measured=q_now, velocity=v_goal)
                 self.times.append(res.solve_time)
                 self.cpu.append(res.cpu_time)
                 if res.blocked:
                     r.blocked_time += self.ctrl_dt
-                self.arm.command(res.q, res.dq)
+                self.arm.command(drive_target(res.q, res.dq, self.ctrl_dt, self.n_sub), res.dq)
                 t_step = time.perf_counter()
                 w.step(self.n_sub)
                 self._measure(dragged)
@@ -227,6 +227,21 @@ class FollowLoop:
         if self.failure is not None:
             raise RunFailed(self.failure.phase, self.failure.reason, report=r) from None
         return r
+
+
+def drive_target(q_end: np.ndarray, dq: np.ndarray, ctrl_dt: float, n_sub: int) -> np.ndarray:
+    """The drives' position target (rad) for a control period that ends at ``q_end`` moving at
+    ``dq`` (rad/s) over ``n_sub`` physics steps.
+
+    PyBullet's joint motor sets each physics step's velocity to ``dq + kp·(target − q)/h`` (with
+    the drives' velocity gain 1, ``btMultiBodyJointMotor``), so a target at the period's *end*
+    adds a correction of ``kp·Δ`` on top of the feed-forward every step and the joint settles one
+    step *ahead* of the command. A joint on the ramp stays on it when the target is the ramp's
+    position at the start of the physics step; over ``n_sub`` steps the target is held, so the
+    ramp's mean over those starts: ``q_end − dq·h·(n_sub + 1)/2`` with ``h = ctrl_dt / n_sub``.
+    """
+    h = ctrl_dt / n_sub
+    return np.asarray(q_end, float) - np.asarray(dq, float) * h * (n_sub + 1) / 2
 
 
 def _obstacles(params: FollowTargetParams, with_obstacle: bool, start: np.ndarray, goal: np.ndarray) -> list[FollowObstacle]:
