@@ -78,3 +78,24 @@ def test_drive_target_keeps_a_pybullet_joint_on_its_ramp():
                 assert worst > 0.9 * speed * h  # one physics step ahead
             else:
                 assert worst < 0.1 * speed * h * n_sub
+
+
+def test_a_suction_tool_is_not_turned_about_its_axis():
+    """The iiwa's home holds its cup pointing down but turned half a turn about the cup's axis from
+    the default task's target_euler_deg (written for the Panda's hand). A cup is symmetric about
+    its axis (``tool_roll: auto`` = free for suction): the target is tracked from the first
+    second, where turning the wrist half a turn at 2 rad/s took 1.6 s and failed the run."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.runners.follow_target import run_follow_target
+
+    def run(roll: str):
+        task = load_task(catalog.find("tasks", "follow_target"), robot_override="kuka_iiwa_suction",
+                         overrides={"follow_target.duration": 2.0, "follow_target.tool_roll": roll})
+        return run_follow_target(task)
+
+    free, tracked = run("auto"), run("tracked")
+    assert free.tool_roll == "free" and tracked.tool_roll == "tracked"
+    assert free.reached and free.orientation_error_deg.max < 0.1 and free.position_error_mm.max < 1.0
+    assert not tracked.reached and tracked.orientation_error_deg.max > 10.0  # still turning after 1 s
+    assert free.samples[0][2] < 1.0 < 170.0 < tracked.samples[0][2]  # the same start, measured both ways

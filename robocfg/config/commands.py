@@ -120,6 +120,11 @@ class FollowTargetParams(Frozen):
         "fixed", description="fixed: target_euler_deg throughout; following: also turns about the motion plane's normal "
                              "by follow_angle_deg·sin(phase) (phase: 2π·t/period).")
     follow_angle_deg: FiniteFloat = Field(30.0, description="Amplitude of the 'following' orientation swing (deg).")
+    tool_roll: Literal["auto", "tracked", "free"] = Field(
+        "auto", description="The TCP's turn about the tool axis (ee_axis). tracked: the whole target orientation is "
+                            "followed and measured. free: the tool is symmetric about its axis, so only where it points "
+                            "is followed and measured (orientation error = angle between the tool axes). auto: free for "
+                            "a suction gripper, tracked otherwise.")
     with_obstacle: bool = False
     obstacles: list[FollowObstacle] = Field(default_factory=list, description="Spawned only with with_obstacle (or --with-obstacle).")
     duration: PositiveFloat = 8.0

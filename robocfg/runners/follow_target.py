@@ -129,6 +129,8 @@ def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool 
         o = result.orientation_error_deg
         moving = ("" if e is None or at_rest else
                   f"RMS {e.rms:.1f} mm" + ("" if o is None else f" / {o.rms:.2f} deg (max {o.max:.1f} deg)") + " after settling, ")
+        if result.tool_roll == "free":
+            tol += " (tool axis)"
         msg = (f"target not reached within {tol}: {moving}residual {result.final_position_error_mm:.1f} mm / "
                f"{result.final_orientation_error_deg:.2f} deg ({result.unreachable_reason})")
         result.warnings.append(msg)

@@ -51,6 +51,7 @@ class FollowTargetResult(SingleRunReport):
     control_rate: float  # Hz (actual: physics rate / substeps)
     safety_margin: float  # m
     settle_time: float  # s
+    tool_roll: str = "tracked"  # "free": orientation error = angle between the tool axes (roll about it not counted)
     success: bool = False
     position_error_mm: Stats | None = None  # after settling
     orientation_error_deg: Stats | None = None
@@ -101,7 +102,8 @@ class FollowTargetResult(SingleRunReport):
 
         rows = [
             (f"position error (after {self.settle_time:g} s)", stats(self.position_error_mm, "mm", 2)),
-            (f"orientation error (after {self.settle_time:g} s)", stats(self.orientation_error_deg, "deg", 3)),
+            (f"{'tool-axis' if self.tool_roll == 'free' else 'orientation'} error (after {self.settle_time:g} s)",
+             stats(self.orientation_error_deg, "deg", 3)),
             ("final error (residual)", f"{self.final_position_error_mm:.3f} mm / {self.final_orientation_error_deg:.4f} deg"),
             ("reached", "yes" if self.reached else f"no ({self.unreachable_reason})"),
         ]

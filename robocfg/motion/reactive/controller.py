@@ -12,7 +12,9 @@ filled from coal distances between convex hulls inside ``trigger`` (:mod:`.colli
 Warm start: the QP is linearised at the previous command (not the noisy measurement), so commands
 are continuous; the measured state re-seeds it only after a deviation above ``resync_tolerance``.
 Failure handling: an infeasible hard-collision QP is re-solved with soft collision constraints,
-and if that fails too the step commands zero velocity. Frames: world, 4×4 transforms, metres.
+and if that fails too the step commands zero velocity. An axis-symmetric tool (``free_roll``) is
+servoed to the target turned about its tool axis to the current roll (:mod:`.tool_roll`), so only
+where it points is tracked. Frames: world, 4×4 transforms, metres.
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from robocfg.collision.shapes import (
 from robocfg.motion.reactive.collision_rows import CollisionRows
 from robocfg.motion.reactive.escape import EscapeRule, EscapeSettings
 from robocfg.motion.reactive.limits import step_bounds
+from robocfg.motion.reactive.tool_roll import nearest_roll
 
 CONTINUOUS_RANGE = 1000.0  # rad: limits written on continuous joints for placo (its own joint limits are off)
 
@@ -55,6 +58,7 @@ class ArmSpec:
     posture: np.ndarray  # rad, the regularisation target (e.g. home)
     other_joints: dict[str, float] = field(default_factory=dict)  # non-arm DOFs held at these values
     collision: list[LinkGeometry] | None = None  # robot collision geometry; None: placo loads the URDF's
+    tool_axis: int = 2  # ee_link axis (0/1/2 = x/y/z) the tool points along (the robot's ee_axis)
 
 
 @dataclass(frozen=True)
@@ -73,6 +77,7 @@ class ReactiveSettings:
     gain: float = 20.0  # 1/s: Cartesian servo gain (the QP is asked to close gain·dt of the error)
     max_linear_speed: float = 1.0  # m/s: cap on the commanded TCP speed
     max_angular_speed: float = 2.0  # rad/s
+    free_roll: bool = False  # an axis-symmetric tool (suction cup): the roll about ArmSpec.tool_axis is not tracked
     escape: EscapeSettings = field(default_factory=EscapeSettings)
 
 
@@ -260,6 +265,13 @@ class ReactiveController:
         target[:3, 3] = self.escape.update(self.t, T_tcp[:3, 3], target[:3, 3], blocking)
         if self.escape.active:
             velocity = None
+        if self.s.free_roll:  # the tool's roll stays where it is: only where it points is servoed
+            ax = self.arm.tool_axis
+            target[:3, :3] = nearest_roll(target[:3, :3], T_tcp[:3, :3], ax)
+            if velocity is not None:
+                velocity = np.asarray(velocity, float).copy()
+                a = target[:3, ax]
+                velocity[3:] -= float(velocity[3:] @ a) * a
         self.task.T_world_frame = self._servo(T_tcp, target, velocity) @ self._T_tcp_ee
         lo, hi = step_bounds(self.q, self.dq, self.arm.lower, self.arm.upper,
                              self.arm.velocity_limits, self.arm.acceleration_limits, self.s.dt)

@@ -51,6 +51,7 @@ def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: s
         upper=np.array([np.inf if urdf.joints[n].type == "continuous" else urdf.joints[n].upper for n in names]),
         velocity_limits=vel * velocity_scale, acceleration_limits=acc,
         posture=np.asarray(arm_cfg.home, float), other_joints=held, collision=collision,
+        tool_axis=AXIS_INDEX[arm_cfg.ee_axis],
     )
 
 
