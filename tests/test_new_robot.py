@@ -9,6 +9,7 @@ import pybullet_data
 import pytest
 import yaml
 from _cli import run_main
+from _sim_helpers import make_task
 
 from robocfg.assets.draft import draft_robot
 from robocfg.assets.draft_yaml import render_yaml
@@ -125,3 +126,28 @@ def test_drafted_panda_runs_gripper_and_pick_place(tmp_path, capsys, monkeypatch
     import json
 
     assert json.loads((tmp_path / "r.json").read_text())["summary"]["success_rate"] == 1.0
+
+
+def test_drafted_gripper_drive_is_capped_at_the_urdf_speed_so_damped_jaws_move(tmp_path):
+    """A jaw joint with ``<dynamics damping>`` (the Unitree Z1's: 1 N·m·s/rad) stalled part-way
+    under PyBullet's position drive, which asks for (stiffness / timestep) × error of speed: the
+    draft caps the drive at the URDF velocity limit, and the jaw closes and reopens fully."""
+    from robocfg.sim.world import World
+
+    text = (ROOT / "tests" / "data" / "sim_onejaw.urdf").read_text()
+    limit = '<limit lower="0.0" upper="0.08" effort="40" velocity="0.2"/>'
+    assert limit in text
+    urdf = tmp_path / "damped_jaw.urdf"
+    urdf.write_text(text.replace(limit, limit + '<dynamics damping="100.0" friction="1.0"/>'))
+    d = draft_robot(parse_urdf(urdf), "damped", tmp_path)
+    assert d.gripper is not None and d.gripper.max_velocity == pytest.approx(0.2)
+    out = tmp_path / "damped.yaml"
+    out.write_text(render_yaml(d))
+    with World(make_task(tmp_path, out)) as w:
+        g = w.robot.arm().gripper
+        g.close()
+        w.step(round(1.0 / w.dt))
+        closed = g.fraction()
+        g.open()
+        w.step(round(1.0 / w.dt))
+        assert closed < 0.05 and g.fraction() > 0.95

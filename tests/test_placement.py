@@ -73,3 +73,18 @@ def test_auto_placement_scales_the_default_task_to_a_kr210():
     e = report.episodes[0]
     assert e.success, (e.failed_phase, e.reason)
     assert any("spots scaled" in w for w in report.warnings)
+
+
+def test_auto_placement_survives_the_trip_to_a_worker_process():
+    """``--workers`` sends the task as its document with ``--robot`` already applied; the robot the
+    file names travels with it, so a worker scales the spots as the parent does (it used to see
+    the KR 210 as the task's own robot and left the Panda's spots out of reach)."""
+    import pickle
+
+    from robocfg.engine import TaskSource
+    from robocfg.motion.placement import resolve_placement
+
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="kuka_kr210")
+    there = pickle.loads(pickle.dumps(TaskSource.of(task))).load()
+    assert there.written_robot == task.written_robot
+    assert resolve_placement(there).params == resolve_placement(task).params

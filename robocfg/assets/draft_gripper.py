@@ -61,6 +61,7 @@ class GripperDraft:
     closing_axis: str  # ee axis of the closing direction (sign in closing_sign)
     closing_sign: float = 1.0  # -1: the fingers close along −closing_axis (one-jaw only)
     fixed_jaw_face: float | None = None  # m, one-jaw: fixed jaw's face along the closing direction
+    max_velocity: float | None = None  # rad/s or m/s: the leaders' URDF velocity limit (None: none given)
 
 
 @dataclass
@@ -148,6 +149,17 @@ def grip_force(urdf: Urdf, ee_link: str, leaders: list[str], pads: list[np.ndarr
     return round(float(min(out)), 3)
 
 
+def rated_velocity(urdf: Urdf, leaders: list[str]) -> float | None:
+    """The slowest leader's URDF velocity limit (rad/s or m/s), or None when none gives one.
+
+    The draft caps the gripper drive with it: PyBullet's position drive otherwise asks for
+    (stiffness / timestep) × error — 12.7 rad/s for the Z1 jaw 0.5 rad from its target — and a
+    joint's ``<dynamics>`` damping at that speed (1 N·m·s/rad there) takes more than the whole
+    drive force, so the jaw stalls half-way (it never reopened after a grasp)."""
+    rated = [urdf.joints[j].velocity for j in leaders if urdf.joints[j].velocity > 0]
+    return round(float(min(rated)), 6) if rated else None
+
+
 def _limits(urdf: Urdf, leaders: list[str]) -> tuple[dict[str, float], dict[str, float]]:
     return ({j: urdf.joints[j].lower for j in leaders}, {j: urdf.joints[j].upper for j in leaders})
 
@@ -177,7 +189,8 @@ def parallel_gripper(urdf: Urdf, resolver: Resolver, ee_link: str, leaders: list
     tcp = float(pad_midpoint(closed_pads)[axis])
     g = GripperDraft("parallel", leaders, [round(open_q[j], 6) for j in leaders], [round(closed_q[j], 6) for j in leaders],
                      pair, round(max(max(gaps), 1e-3), 4), round(max(min(gaps), 0.0), 4),
-                     grip_force(urdf, ee_link, leaders, closed_pads, closed_q), AXES[closing])
+                     grip_force(urdf, ee_link, leaders, closed_pads, closed_q), AXES[closing],
+                     max_velocity=rated_velocity(urdf, leaders))
     return GripperGeometry(g, AXES[axis], tcp)
 
 
@@ -237,7 +250,7 @@ def _jaw_at(urdf: Urdf, resolver: Resolver, ee_link: str, joint: str, pair: list
     tcp = float(pad_midpoint(pads)[axis])
     g = GripperDraft("one_jaw", [joint], [round(open_q[joint], 6)], [round(closed_q[joint], 6)], pair,
                      round(gap_open, 4), round(max(gap_closed, 0.0), 4), grip_force(urdf, ee_link, [joint], pads, closed_q), AXES[closing],
-                     sign, round(face, 4))
+                     sign, round(face, 4), rated_velocity(urdf, [joint]))
     return GripperGeometry(g, AXES[axis], tcp)
 
 

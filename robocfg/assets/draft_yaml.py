@@ -77,6 +77,12 @@ def render_yaml(d: RobotDraft) -> str:
         lines += [
             "      # CHECK: about 20 N per pad (the lever to the pads; capped by the URDF effort).",
             f"      max_force: {_num(g.max_force)}",
+        ]
+        if g.max_velocity is not None:
+            lines += ["      # The URDF's velocity limit: without it the drive asks for more speed than the joint's",
+                      "      # damping lets max_force reach, and the jaws stall part-way.",
+                      f"      max_velocity: {_num(g.max_velocity)}"]
+        lines += [
             "      lateral_friction: 1.0",
             "    collision_filter:",
             f"      ignore_links: [{', '.join(g.finger_links)}]",

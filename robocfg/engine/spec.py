@@ -25,13 +25,16 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class TaskSource:
     """A task as data that can travel to another process: the task document as validated (robot
-    override and dotted-key overrides already applied); ``load()`` checks it again there."""
+    override and dotted-key overrides already applied); ``load()`` checks it again there.
+    ``written_robot``: the robot YAML the file itself names (before ``--robot``), which the
+    document no longer says and ``placement: auto`` scales from."""
 
     doc: YamlDocument
+    written_robot: Path | None = None
 
     @classmethod
     def of(cls, task: CheckedTask) -> TaskSource:
-        return cls(task.doc)
+        return cls(task.doc, task.written_robot)
 
     @classmethod
     def from_path(cls, path: str | Path, robot: str | None = None,
@@ -43,7 +46,10 @@ class TaskSource:
     def load(self) -> CheckedTask:
         from robocfg.checks.task import check_task_document
 
-        return check_task_document(self.doc)
+        task = check_task_document(self.doc)
+        if self.written_robot is not None:
+            task.written_robot = self.written_robot
+        return task
 
 
 @dataclass(frozen=True)
