@@ -88,3 +88,29 @@ def test_auto_placement_survives_the_trip_to_a_worker_process():
     there = pickle.loads(pickle.dumps(TaskSource.of(task))).load()
     assert there.written_robot == task.written_robot
     assert resolve_placement(there).params == resolve_placement(task).params
+
+
+def test_auto_placement_raises_the_work_surface_for_an_arm_that_cannot_reach_the_floor():
+    """The dual-arm lift's arm bases are 0.76 m up: no scaling brings the floor spots into reach.
+    ``auto`` puts them on a stand whose top is where that arm reaches well (validate's check is
+    clean) and the default pick-place runs on it; the Panda, which reaches the floor, gets none."""
+    from robocfg.motion.placement import STAND, resolve_placement
+    from robocfg.runners.pick_place import PickPlaceRunner
+
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="dual_arm_lift")
+    given = task.config.pick_place
+    assert any(r.nominal for r in pick_place_reach(task, params=given.model_copy(update={"placement": "world"})))
+    placed = resolve_placement(task)
+    stand = placed.stand
+    assert stand is not None and stand.name == STAND and "stand" in placed.note
+    top = stand.position[2] + stand.size[2]
+    assert 0.4 < top < 0.77  # between the floor and the arm bases, as the note says
+    assert f"top {top:.2f} m high" in placed.note
+    assert placed.reach == [] and PickPlaceRunner.static_problems(task) == []
+    for x, y in (placed.params.object.position[:2], placed.params.place_position[:2]):
+        assert abs(x - stand.position[0]) < stand.size[0] / 2 and abs(y - stand.position[1]) < stand.size[1] / 2
+    report, _ = run_pick_place(task, episodes=1, seed=0)
+    e = report.episodes[0]
+    assert e.success, (e.failed_phase, e.reason)
+    assert abs(e.object_final[2] - (top + 0.025)) < 0.005  # the cube rests on the stand's top
+    assert resolve_placement(load_task(catalog.find("tasks", "pick_place"))).stand is None

@@ -74,17 +74,23 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
 
     phases = ("setup", "pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract")
 
+    def __init__(self, task: CheckedTask, options: RunOptions, timing: BatchTiming | None = None):
+        from robocfg.motion.placement import resolve_placement, with_stand
+
+        # Before the world is built: placement: auto may raise the work surface (a stand in the scene).
+        self.placement = resolve_placement(task, task.robots[0].config.arm(options.arm).name)
+        super().__init__(with_stand(task, self.placement.stand), options, timing)
+
     def prepare(self) -> None:
         from robocfg.assets.object_shape import object_shape
         from robocfg.checks.grip_force import pad_force
         from robocfg.grasp.gripper_model import measure_gripper
         from robocfg.kinematics.model import KinematicModel
         from robocfg.motion.limits import limits_from_robot
-        from robocfg.motion.placement import resolve_placement
 
         robot = self.task.robots[0]
         self.arm_cfg = robot.config.arm(self.options.arm)
-        placement = resolve_placement(self.task, self.arm_cfg.name)
+        placement = self.placement
         self.params: PickPlaceParams = placement.params  # world positions
         self.placement_note = placement.note
         self.handle = self.world.robot.arm(self.arm_cfg.name)
