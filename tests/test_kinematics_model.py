@@ -154,3 +154,19 @@ def test_bad_inputs() -> None:
         model.fk(np.zeros(model.nq + 1))
     with pytest.raises(RobocfgError):
         KinematicModel.from_robot(load_robot(PANDA), base_pose=np.full((4, 4), np.nan))
+
+
+def test_fk_positions_are_the_translations_of_fk() -> None:
+    """One call for a sampled path gives, bit for bit, the positions of ``fk`` row by row; frame
+    names are looked up once and stay right (a cached id must not leak between names)."""
+    robot = load_robot(PANDA)
+    model = KinematicModel.from_robot(robot)
+    finger = robot.config.arm().gripper.finger_links[0]
+    rng = np.random.default_rng(3)
+    qs = rng.uniform(model.lower, model.upper, (9, model.nq))
+    for frame in ("ee", "tcp", "ee", finger):
+        want = np.array([model.fk(q, frame)[:3, 3] for q in qs])
+        assert model.fk_positions(qs, frame).tobytes() == want.tobytes(), frame
+    assert np.linalg.norm(model.fk_positions(qs[:1], "ee") - model.fk_positions(qs[:1], finger)) > 1e-3
+    with pytest.raises(RobocfgError, match="shape"):
+        model.fk_positions(qs[:, :3], "ee")

@@ -101,9 +101,10 @@ def top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> list[list[Grasp]]:
         mid = float(proj.max() + proj.min()) / 2
         options.append((round(width / SAME_WIDTH), order, a, width, mid))
     groups = []
+    fixed = _HeightCheck.of(obj) if options else None
     for _, _, a, width, mid in sorted(options):
         closing = np.array([math.cos(a), math.sin(a), 0.0])
-        z = _grasp_height(obj, boxes, closing, width)
+        z = _grasp_height(obj, boxes, closing, width, fixed)
         if z is None:
             continue
         centre = np.array([obj.position[0] + mid * closing[0], obj.position[1] + mid * closing[1], z])
@@ -112,7 +113,23 @@ def top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> list[list[Grasp]]:
     return groups
 
 
-def _grasp_height(obj: LyingObject, boxes: GripperBoxes, closing: np.ndarray, width: float) -> float | None:
+@dataclass(frozen=True)
+class _HeightCheck:
+    """What every closing direction's height search of one object shares: its surface points and
+    the same raised by ``PALM_MARGIN`` (N, 3, world, m), its top and bottom heights (m)."""
+
+    points: np.ndarray
+    top: float
+    bottom: float
+
+    @classmethod
+    def of(cls, obj: LyingObject) -> _HeightCheck:
+        P = obj.surface_points()
+        return cls(np.concatenate([P, P + np.array([0.0, 0.0, PALM_MARGIN])]), obj.top_z, obj.bottom_z)
+
+
+def _grasp_height(obj: LyingObject, boxes: GripperBoxes, closing: np.ndarray, width: float,
+                  fixed: _HeightCheck | None = None) -> float | None:
     """TCP height (m, world) of a top-down grasp closing along ``closing``: the object's mid-height
     or, where the palm or a linkage would touch the object there (checked on the gripper's
     oriented link boxes at every measured opening down to ``width``, the object raised by
@@ -123,11 +140,10 @@ def _grasp_height(obj: LyingObject, boxes: GripperBoxes, closing: np.ndarray, wi
     R = grasp_rotation(np.array([0.0, 0.0, -1.0]), closing)
     sweep = boxes.closing_sweep(width)
     tip = float(sweep.hi[sweep.finger, 0].max())
-    top, bottom = obj.top_z, obj.bottom_z
+    fixed = fixed or _HeightCheck.of(obj)
+    top, bottom, P = fixed.top, fixed.bottom, fixed.points
     lowest = max((top + bottom) / 2, obj.support_z + GROUND_MARGIN + tip)
     highest = top - min(MIN_GRIP_DEPTH, (top - bottom) / 2) + min(tip, PAD_REACH)
-    P = obj.surface_points()
-    P = np.concatenate([P, P + np.array([0.0, 0.0, PALM_MARGIN])])
     centre_xy = obj.position[:2]
     for z in np.arange(lowest, highest + 1e-9, HEIGHT_STEP):
         local = (P - [centre_xy[0], centre_xy[1], z]) @ R

@@ -75,6 +75,10 @@ class KinematicModel:
     def __post_init__(self) -> None:
         # OP_FRAME: a URDF link that happens to be called 'tcp' is a BODY frame and stays reachable by type
         self._tcp_id = int(self.model.getFrameId(TCP_FRAME, pin.FrameType.OP_FRAME))
+        self._frame_ids: dict[str, int] = {TCP_FRAME: self._tcp_id}
+        # fixed after construction (``wrap``/``continuous`` are not changed in place): asked per IK query
+        self._any_wrap = bool(self.wrap.any())
+        self._any_continuous = self.continuous is not None and bool(self.continuous.any())
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -168,7 +172,7 @@ class KinematicModel:
     @property
     def any_wrap(self) -> bool:
         """True if some joint is continuous or ≥ 2π wide (wrapped instead of clamped)."""
-        return bool(self.wrap.any())
+        return self._any_wrap
 
     @property
     def mid(self) -> np.ndarray:
@@ -177,9 +181,10 @@ class KinematicModel:
 
     def frame_id(self, frame: str = TCP_FRAME) -> int:
         """pinocchio frame index of ``"tcp"``, ``"ee"`` (the ee_link) or any link name."""
-        if frame == TCP_FRAME:
-            return self._tcp_id
-        return _frame_id(self.model, self.ee_link if frame == "ee" else frame)
+        fid = self._frame_ids.get(frame)
+        if fid is None:  # looked up once per name (the model's frames do not change)
+            fid = self._frame_ids[frame] = _frame_id(self.model, self.ee_link if frame == "ee" else frame)
+        return fid
 
     def frame_name(self, frame: str = TCP_FRAME) -> str:
         """The pinocchio frame name behind ``frame`` ("ee" → the ee_link)."""
@@ -191,6 +196,20 @@ class KinematicModel:
         fid = self.frame_id(frame)
         pin.forwardKinematics(self.model, self.data, q)
         return pin.updateFramePlacement(self.model, self.data, fid).homogeneous.copy()
+
+    def fk_positions(self, qs: np.ndarray, frame: str = TCP_FRAME) -> np.ndarray:
+        """World positions (n, 3), m, of ``frame`` at each row of ``qs`` (n, nq): the translations
+        of :meth:`fk`, for sampling a path in one call."""
+        qs = np.asarray(qs, dtype=float)
+        if qs.ndim != 2 or qs.shape[1] != self.nq:
+            raise RobocfgError(f"expected rows of {self.nq} joint values ({', '.join(self.joint_names)}), got shape {qs.shape}")
+        model, data, fid = self.model, self.data, self.frame_id(frame)
+        fk, place = pin.forwardKinematics, pin.updateFramePlacement
+        out = np.empty((len(qs), 3))
+        for k, q in enumerate(qs):
+            fk(model, data, q)
+            out[k] = place(model, data, fid).translation
+        return out
 
     def jacobian(self, q: np.ndarray, frame: str = TCP_FRAME) -> np.ndarray:
         """(6, nq) Jacobian of ``frame``: rows (v, ω) of the frame origin, world-aligned axes."""
@@ -228,7 +247,7 @@ class KinematicModel:
         solver = self.solver(backend)
         seed = self.home if seed_q is None else np.asarray(seed_q, dtype=float)
         res = solver.solve(target, seed_q=seed, frame=frame, time_budget=time_budget, position_only=position_only, rng=rng)
-        if self.continuous is not None and self.continuous.any() and np.all(np.isfinite(seed)):
+        if self._any_continuous and self.continuous is not None and np.isfinite(seed).all():
             # The same pose with the least travel from the seed: a wrist at π+0.1 stays there, not at −π+0.1.
             turns = np.round((seed - res.q) / (2 * math.pi))
             res.q = np.where(self.continuous, res.q + 2 * math.pi * turns, res.q)
@@ -237,11 +256,11 @@ class KinematicModel:
     def solver(self, backend: str | None = None) -> IKSolver:
         """The (cached) solver instance of ``backend`` (default: the robot YAML's ``ik_backend``),
         e.g. to change its tolerances or its ``clock``."""
-        from robocfg.kinematics.ik.registry import get_backend
-
         name = backend or self.default_backend
         solver = self._solvers.get(name)
         if solver is None:
+            from robocfg.kinematics.ik.registry import get_backend
+
             solver = self._solvers[name] = get_backend(name)(self)
         return solver
 

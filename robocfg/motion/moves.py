@@ -177,7 +177,7 @@ class ArmMover:
         by c scales accelerations by 1/c²."""
         t = np.linspace(0.0, traj.duration, ACCEL_SAMPLES)
         q, _, _ = traj.evaluate(t)
-        P = np.array([self.model.fk(qi, "ee")[:3, 3] for qi in q])
+        P = self.model.fk_positions(q, "ee")
         peak = float(np.linalg.norm(np.diff(P, 2, axis=0), axis=1).max()) / (t[1] - t[0]) ** 2
         return max(1.0, math.sqrt(peak / max(a_max, MIN_ACCELERATION)))
 
@@ -187,10 +187,7 @@ class ArmMover:
         dt = self.world.dt
         n = math.ceil(traj.duration / dt - 1e-9)
         q_ref, qd_ref, _ = traj.evaluate(np.arange(1, n + 1) * dt)
-        q_ref, qd_ref = q_ref.tolist(), qd_ref.tolist()  # once, not per step
-        for k in range(n):
-            self.arm.command(q_ref[k], qd_ref[k])
-            self.step(1)
+        self.world.play(self.arm, q_ref, qd_ref, self.on_step)
 
     def time_limit(self, planned: float | None, factor: float = 1.0) -> float:
         """Time (s) a move may take: the fixed ``timeout``, else the planned duration (s) ×

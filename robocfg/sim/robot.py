@@ -38,6 +38,8 @@ if TYPE_CHECKING:
     from robocfg.sim.mimic import MimicGears
 
 MOVABLE_TYPES = (p.JOINT_REVOLUTE, p.JOINT_PRISMATIC)
+# (token, joint indices, position gains, velocity gains, forces, drives): see RobotHandle.motor_plan
+MotorPlan = tuple[object, list[int], list[float], list[float], list[float], list["Drive"]]
 
 
 @dataclass
@@ -77,7 +79,7 @@ class RobotHandle:
         self.dof_index = {n: k for k, n in enumerate(self.movable_joints)}
         self._movable_indices = [self.joint_index[n] for n in self.movable_joints]
         self.drives: dict[str, Drive] = {}
-        self._fast: dict[tuple[str, ...], tuple] = {}
+        self._fast: dict[tuple[str, ...], MotorPlan] = {}
         self._drive_tokens: dict[tuple[str, ...], object] = {}
         self.mimic: MimicGears | None = None  # set by the World
         self.arms: dict[str, ArmHandle] = {a.name: ArmHandle(self, a) for a in self.config.arms}
@@ -163,16 +165,9 @@ class RobotHandle:
     def _command_fast(self, names: Sequence[str], q: Sequence[float] | np.ndarray, velocities: Sequence[float] | np.ndarray | None) -> bool:
         """The per-step path: one motor call with gains cached per joint list. False → slow path
         (a joint without a drive yet, or with a speed cap)."""
-        key = tuple(names)
-        plan = self._fast.get(key)
-        if plan is None or plan[0] is not self._drive_list(key):
-            maybe = [self.drives.get(n) for n in key]
-            drives = [d for d in maybe if d is not None]
-            if len(drives) < len(maybe) or any(d.max_velocity is not None for d in drives):
-                return False
-            plan = self._fast[key] = (
-                self._drive_list(key), [self.joint_index[n] for n in key], [d.position_gain for d in drives],
-                [d.velocity_gain for d in drives], [d.force for d in drives], drives)
+        plan = self.motor_plan(tuple(names))
+        if plan is None:
+            return False
         _, idx, kp, kd, force, drives = plan
         # lists (a trajectory converted once) are sent as they are: no per-step array round trip
         targets = q if type(q) is list else np.asarray(q, dtype=float).tolist()
@@ -188,6 +183,26 @@ class RobotHandle:
                                     targetVelocities=speeds, positionGains=kp, velocityGains=kd, forces=force,
                                     physicsClientId=self.client)
         return True
+
+    def motor_plan(self, key: tuple[str, ...]) -> MotorPlan | None:
+        """The cached motor settings of joints ``key`` for one ``setJointMotorControlArray`` call:
+        (token, PyBullet joint indices, position gains, velocity gains, forces, drives), valid while
+        ``token is self.drive_token(key)`` (a drive of ``key`` replaced: a new token). None when a
+        joint has no drive yet or a speed cap (those go through ``setJointMotorControl2``)."""
+        plan = self._fast.get(key)
+        if plan is None or plan[0] is not self._drive_list(key):
+            maybe = [self.drives.get(n) for n in key]
+            drives = [d for d in maybe if d is not None]
+            if len(drives) < len(maybe) or any(d.max_velocity is not None for d in drives):
+                return None
+            plan = self._fast[key] = (
+                self._drive_list(key), [self.joint_index[n] for n in key], [d.position_gain for d in drives],
+                [d.velocity_gain for d in drives], [d.force for d in drives], drives)
+        return plan
+
+    def drive_token(self, key: tuple[str, ...]) -> object | None:
+        """The current token of joints ``key`` (None: some drive was replaced since the last plan)."""
+        return self._drive_tokens.get(key)
 
     def _drive_list(self, key: tuple[str, ...]) -> object:
         """A token that changes whenever a drive of ``key`` is replaced (the fast path's cache key)."""

@@ -37,7 +37,7 @@ from robocfg.sim.gripper import make_gripper
 from robocfg.sim.loading import filter_gripper_linkage, load_robot_urdf
 from robocfg.sim.mimic import MimicGears
 from robocfg.sim.queries import SceneQueries
-from robocfg.sim.robot import RobotHandle
+from robocfg.sim.robot import ArmHandle, RobotHandle
 
 MAX_JOINT_VELOCITY = 100.0  # rad/s or m/s: beyond this the physics is taken as diverged
 MAX_BODY_SPEED = 50.0  # m/s for free bodies
@@ -240,21 +240,35 @@ class World(SceneQueries):
     # ---- stepping -----------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance ``n`` physics steps of ``dt``; grippers update after each; divergence raises."""
-        c, clock = self.client, time.perf_counter
         for _ in range(n):
-            t0 = clock()
-            p.stepSimulation(physicsClientId=c)
-            self.physics_seconds += clock() - t0
-            self.steps += 1
-            self.t = self.steps * self.dt
-            for g in self._grippers:
-                g.update()
-            if self.steps % self._check_every == 0:
-                self._check()
-                if self.should_stop is not None and self.should_stop():
-                    raise RunInterrupted("simulation", "SIGINT/SIGTERM")
-            for hook in self.step_hooks:
-                hook()
+            self._advance()
+
+    def _advance(self) -> None:
+        """One physics step and its bookkeeping (clock, grippers, periodic checks, step hooks):
+        the body of :meth:`step`, shared with :func:`robocfg.sim.playback.play_rows`."""
+        clock = time.perf_counter
+        t0 = clock()
+        p.stepSimulation(physicsClientId=self.client)
+        self.physics_seconds += clock() - t0
+        self.steps = steps = self.steps + 1
+        self.t = steps * self.dt
+        for g in self._grippers:
+            g.update()
+        if steps % self._check_every == 0:
+            self._check()
+            if self.should_stop is not None and self.should_stop():
+                raise RunInterrupted("simulation", "SIGINT/SIGTERM")
+        for hook in self.step_hooks:
+            hook()
+
+    def play(self, arm: ArmHandle, q: np.ndarray, qd: np.ndarray, after: Callable[[], None] | None = None) -> None:
+        """Play a sampled joint trajectory on ``arm``: before physics step k, position targets
+        ``q[k]`` (rad or m) and target velocities ``qd[k]`` (rad/s or m/s), (steps, joints) arrays;
+        ``after()`` after every step. The same motor commands and steps as ``arm.command(q[k],
+        qd[k])`` then ``step()`` per row (see :func:`robocfg.sim.playback.play_rows`)."""
+        from robocfg.sim.playback import play_rows
+
+        play_rows(self, arm, q, qd, after)
 
     def snapshot(self) -> int:
         """Save the physics state (bodies, joints, contacts) to come back to with ``restore``.
@@ -279,18 +293,18 @@ class World(SceneQueries):
         self._check()
 
     def _check(self) -> None:
-        c, vmax = self.client, self.max_joint_velocity
+        c, vmax, vbody = self.client, self.max_joint_velocity, self.max_body_speed
         for r in self.robots:
-            if not r.movable_joints:
+            idx = r._movable_indices
+            if not idx:
                 continue
-            for name, s in zip(r.movable_joints, p.getJointStates(r.body_id, r._movable_indices, physicsClientId=c),
-                               strict=True):
-                if not abs(s[1]) <= vmax:  # also catches NaN
-                    raise PhysicsDiverged(self.t, f"robot {r.name!r} joint {name!r} velocity {s[1]:.3g}")
+            for k, s in enumerate(p.getJointStates(r.body_id, idx, physicsClientId=c)):
+                if not -vmax <= s[1] <= vmax:  # also catches NaN
+                    raise PhysicsDiverged(self.t, f"robot {r.name!r} joint {r.movable_joints[k]!r} velocity {s[1]:.3g}")
         for bid in self._dynamic:
-            lin, _ = p.getBaseVelocity(bid, physicsClientId=c)
+            lin = p.getBaseVelocity(bid, physicsClientId=c)[0]
             speed = math.sqrt(lin[0] ** 2 + lin[1] ** 2 + lin[2] ** 2)
-            if not speed <= self.max_body_speed:
+            if not speed <= vbody:
                 name = next((k for k, v in self.bodies.items() if v == bid), str(bid))
                 raise PhysicsDiverged(self.t, f"body {name!r} speed {speed:.3g} m/s")
 

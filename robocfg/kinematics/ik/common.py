@@ -4,15 +4,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from time import perf_counter
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from robocfg.errors import RobocfgError
+from robocfg.kinematics.ik.result import IKResult
 
 if TYPE_CHECKING:
-    from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
 
 TWO_PI = 2 * math.pi
@@ -45,7 +46,7 @@ def check_seed(model: KinematicModel, seed_q: np.ndarray) -> np.ndarray:
     q = np.array(seed_q, dtype=float).reshape(-1)
     if q.shape[0] != model.nq:
         raise RobocfgError(f"seed_q has {q.shape[0]} values; the arm has {model.nq} joints")
-    if not all(math.isfinite(v) for v in q.tolist()):
+    if not np.isfinite(q).all():
         raise RobocfgError("seed_q contains NaN or infinite values")
     return into_limits(model, q)
 
@@ -111,8 +112,6 @@ def search(km: KinematicModel, descend: Descend, q0: np.ndarray, deadline: float
     search, so the answer is the same on a loaded machine as on a quiet one.
     Returns (best q by score, total iterations, restarts).
     """
-    from time import perf_counter
-
     clock = clock or perf_counter
     if max_total_iter is not None:
         deadline = math.inf
@@ -163,10 +162,6 @@ class Descent:
 def finish(km: KinematicModel, backend: str, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool,
            tol_pos: float, tol_rot: float, t0: float, iters: int, restarts: int) -> IKResult:
     """The IKResult for ``q``: residuals by FK (m, rad), convergence against the tolerances."""
-    from time import perf_counter
-
-    from robocfg.kinematics.ik.result import IKResult
-
     pin.forwardKinematics(km.model, km.data, q)
     d = pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)
     pe = math.sqrt(d.translation.dot(d.translation))

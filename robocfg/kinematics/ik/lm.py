@@ -62,6 +62,7 @@ class LMSolver:
         self.max_iter, self.mu, self.lambda0 = max_iter, mu, lambda0
         self.stall_ratio, self.stall_n = stall_ratio, stall_n
         self.restart_candidates = restart_candidates
+        self._eye = np.eye(model.nq)  # read only: the damping term's identity
 
     def solve(self, target: np.ndarray, seed_q: np.ndarray, frame: str = "tcp",
               time_budget: float = 0.02, position_only: bool = False,
@@ -107,7 +108,7 @@ class LMSolver:
         tp2, tr2 = self.tol_pos**2, self.tol_rot**2
         mu, lam0 = self.mu, self.lambda0
         ratio, stall_n = self.stall_ratio, self.stall_n
-        eye = np.eye(km.nq)
+        eye = self._eye if self._eye.shape[0] == km.nq else np.eye(km.nq)
         cjj, ufp, gfj, log6 = pin.computeJointJacobians, pin.updateFramePlacement, pin.getFrameJacobian, pin.log6
         mn, mx, nnz = np.minimum, np.maximum, np.count_nonzero
         clock = self.clock
