@@ -14,11 +14,14 @@ The drives' recorded targets (``RobotHandle.drives``) end at the last row sent, 
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pybullet as p
+
+from robocfg.errors import RunInterrupted
 
 if TYPE_CHECKING:
     from robocfg.sim.robot import ArmHandle
@@ -43,8 +46,14 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
         return
     token, idx, kp, kd, force, drives = plan
     body, client, mode = robot.body_id, robot.client, p.POSITION_CONTROL
-    send, advance, tokens = p.setJointMotorControlArray, world._advance, robot.drive_token
+    send, tokens = p.setJointMotorControlArray, robot.drive_token
+    # World._advance, inlined (keep the two in step): physics step, clock, grippers, the periodic
+    # divergence check and stop request, step hooks. Locals instead of attribute lookups: this loop
+    # runs once per physics step and is most of robocfg's per-step cost.
+    stepsim, clock, dt, every = p.stepSimulation, time.perf_counter, world.dt, world._check_every
+    grippers, hooks = world._grippers, world.step_hooks
     sent: tuple[list[float], list[float]] | None = None
+    physics = 0.0
     try:
         for row, speeds in zip(q_rows, qd_rows):  # noqa: B905 - shapes checked above
             if tokens(key) is not token:  # a drive of the arm was replaced (new gains): as command() would
@@ -52,18 +61,29 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
                 if plan is None:
                     arm.command(row, speeds)
                     sent = None
-                    advance()
-                    if after is not None:
-                        after()
-                    continue
-                token, idx, kp, kd, force, drives = plan
-            send(body, idx, mode, targetPositions=row, targetVelocities=speeds, positionGains=kp, velocityGains=kd,
-                 forces=force, physicsClientId=client)
-            sent = (row, speeds)
-            advance()
+                else:
+                    token, idx, kp, kd, force, drives = plan
+            if plan is not None:
+                send(body, idx, mode, targetPositions=row, targetVelocities=speeds, positionGains=kp,
+                     velocityGains=kd, forces=force, physicsClientId=client)
+                sent = (row, speeds)
+            t0 = clock()
+            stepsim(physicsClientId=client)
+            physics += clock() - t0
+            world.steps = steps = world.steps + 1
+            world.t = steps * dt
+            for g in grippers:
+                g.update()
+            if steps % every == 0:
+                world._check()
+                if world.should_stop is not None and world.should_stop():
+                    raise RunInterrupted("simulation", "SIGINT/SIGTERM")
+            for hook in hooks:
+                hook()
             if after is not None:
                 after()
     finally:
+        world.physics_seconds += physics
         if sent is not None:  # the drives remember the last targets sent, as command() leaves them
             for d, v, w in zip(drives, *sent):  # noqa: B905 - shapes checked above
                 d.target, d.target_velocity = v, w

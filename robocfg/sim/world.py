@@ -245,7 +245,8 @@ class World(SceneQueries):
 
     def _advance(self) -> None:
         """One physics step and its bookkeeping (clock, grippers, periodic checks, step hooks):
-        the body of :meth:`step`, shared with :func:`robocfg.sim.playback.play_rows`."""
+        the body of :meth:`step`; :func:`robocfg.sim.playback.play_rows` inlines it (keep the two
+        in step)."""
         clock = time.perf_counter
         t0 = clock()
         p.stepSimulation(physicsClientId=self.client)
