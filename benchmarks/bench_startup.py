@@ -1,53 +1,149 @@
-"""Whole-process wall time of `robocfg --help` and `robocfg validate` (all built-ins).
+"""Start-up of a fresh robocfg process: CLI commands, importing the pick-place runner, and the
+time until a pick-place process's world is ready and its first episode is done.
 
-Usage: python benchmarks/bench_startup.py [--runs 15]
+Usage: python benchmarks/bench_startup.py [--runs 15] [--only help,run-help,...] [--json out.json]
 
-Each command runs as a fresh process (the installed `robocfg` console script), ``--runs`` times
-after one warm-up run (file cache); prints min / median / max wall time, the median CPU time
-(user + sys of the child: what the wall time would be on an idle core) and the goal. The
-machine's 1-minute load average is printed too: other processes on a 2-core machine inflate
-the wall times, so look at the min and CPU columns when the load is not ~0.
+Every row is a fresh process (``python -m robocfg`` with the interpreter running this script),
+run in ``--root`` (default: this script's checkout; the current directory comes first on the
+child's ``sys.path``, so ``--root`` picks the checkout measured), ``--runs`` times after one
+warm-up run (file cache). Rows:
+
+* ``help``: ``robocfg --help``; ``run-help``: ``robocfg run pick-place --help``;
+* ``validate-task``: ``robocfg validate`` of the shipped ``pick_place.yaml`` (its robot too);
+  ``validate-all``: ``robocfg validate`` (every built-in robot and task);
+* ``import-runner``: ``python -c "import robocfg.runners.pick_place"``;
+* ``run-1``: ``robocfg run pick-place -n 1 -q`` (the whole process, first episode included);
+* ``first-episode``: a process using the per-episode API as a pool worker or Ray actor does
+  (``robocfg.load_task`` → ``open_session`` → ``session.run(0)`` → ``session.run(1)``), timed from
+  just before the spawn: *imports* (robocfg.engine and the task loader imported), *task* (loaded
+  and checked), *world* (the world built: the **fixed start** a process pays before its first
+  episode), *episode 0* done, and *episode 1* alone (what each further episode costs).
+
+For each row: min / median / max wall time and the median CPU time of the child (user + sys:
+what the wall time would be on an idle core). The machine's 1-minute load average is printed:
+on a shared 2-core machine other processes inflate the wall times, so read the min and CPU
+columns when the load is not ~0.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import resource
-import shutil
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-CASES = [("robocfg --help", ["--help"], 0.3), ("robocfg validate", ["validate"], 1.5)]
+ROOT = Path(__file__).resolve().parent.parent  # replaced by --root
+ROBOCFG = [sys.executable, "-m", "robocfg"]
+
+# row → (argv, goal in s or None)
+CASES: dict[str, tuple[list[str], float | None]] = {
+    "help": ([*ROBOCFG, "--help"], 0.3),
+    "run-help": ([*ROBOCFG, "run", "pick-place", "--help"], 0.5),
+    "validate-task": ([*ROBOCFG, "validate", "robocfg/data/tasks/pick_place.yaml"], 0.5),
+    "validate-all": ([*ROBOCFG, "validate"], 1.5),
+    "import-runner": ([sys.executable, "-c", "import robocfg.runners.pick_place"], None),
+    "run-1": ([*ROBOCFG, "run", "pick-place", "-n", "1", "-q"], None),
+}
+
+# the first-episode child: prints wall-clock stamps (time.time(), comparable with the parent's)
+# and its own CPU time at each mark, as one JSON line
+_FIRST = """
+import json, time
+marks = {}
+def mark(name):
+    marks[name] = (time.time(), time.process_time())
+from robocfg.checks.task import load_task
+from robocfg.config import catalog
+from robocfg.engine import RunOptions, open_session
+mark("imports")
+task = load_task(catalog.find("tasks", "pick_place"))
+mark("task")
+session = open_session(task, RunOptions(seed=0, episodes=2))
+mark("world")
+session.run(0)
+mark("episode 0")
+session.run(1)
+mark("episode 1")
+session.close()
+print(json.dumps(marks))
+"""
+FIRST_MARKS = ("imports", "task", "world", "episode 0")
+FIRST_GOAL = {"world": 0.5}  # the issue's goal for the fixed start
+
+
+def _set_root(root: Path) -> None:
+    global ROOT
+    ROOT = root
+
+
+def _timed(argv: list[str]) -> tuple[float, float, str]:
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, out.stdout
+
+
+def _row(label: str, wall: list[float], cpu: list[float], goal: float | None) -> dict:
+    med = statistics.median(wall)
+    ok = "" if goal is None else ("yes" if med <= goal else "NO")
+    print(f"{label:<26}{min(wall):>8.3f}{med:>10.3f}{max(wall):>8.3f}{statistics.median(cpu):>8.3f}"
+          f"{'' if goal is None else f'{goal:.2f}':>8}  {ok}")
+    return {"row": label, "min_s": min(wall), "median_s": med, "max_s": max(wall),
+            "cpu_median_s": statistics.median(cpu), "goal_s": goal}
+
+
+def _first_episode(runs: int) -> list[dict]:
+    argv = [sys.executable, "-c", _FIRST]
+    _timed(argv)  # warm-up
+    wall: dict[str, list[float]] = {m: [] for m in (*FIRST_MARKS, "episode 1 alone")}
+    cpu: dict[str, list[float]] = {m: [] for m in wall}
+    for _ in range(runs):
+        t0 = time.time()
+        _, _, out = _timed(argv)
+        marks = json.loads(out.strip().splitlines()[-1])
+        for m in FIRST_MARKS:
+            wall[m].append(marks[m][0] - t0)
+            cpu[m].append(marks[m][1])
+        wall["episode 1 alone"].append(marks["episode 1"][0] - marks["episode 0"][0])
+        cpu["episode 1 alone"].append(marks["episode 1"][1] - marks["episode 0"][1])
+    return [_row(f"first-episode: {m}", wall[m], cpu[m], FIRST_GOAL.get(m)) for m in wall]
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=15)
+    ap.add_argument("--only", default="", help="comma-separated rows (default: all), e.g. help,first-episode")
+    ap.add_argument("--json", type=Path, default=None, help="write the rows here")
+    ap.add_argument("--root", type=Path, default=ROOT, help="the checkout to measure (default: this one)")
     args = ap.parse_args()
-    exe = shutil.which("robocfg", path=str(Path(sys.executable).parent)) or shutil.which("robocfg")
-    if exe is None:
-        sys.exit("robocfg is not installed in this environment")
-    root = Path(__file__).resolve().parent.parent
-    print(f"load average before: {os.getloadavg()[0]:.2f}   runs: {args.runs}   cwd: {root}")
-    print(f"{'command':<22}{'min s':>8}{'median s':>10}{'max s':>8}{'CPU s':>8}{'goal s':>8}  ok")
-    for label, argv, goal in CASES:
-        subprocess.run([exe, *argv], cwd=root, capture_output=True, check=True)  # warm-up
-        times, cpu = [], []
-        for _ in range(args.runs):
-            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-            t0 = time.perf_counter()
-            subprocess.run([exe, *argv], cwd=root, capture_output=True, check=True)
-            times.append(time.perf_counter() - t0)
-            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-            cpu.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
-        med = statistics.median(times)
-        print(f"{label:<22}{min(times):>8.3f}{med:>10.3f}{max(times):>8.3f}{statistics.median(cpu):>8.3f}{goal:>8.2f}"
-              f"  {'yes' if med < goal else 'NO'}")
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    _set_root(args.root.resolve())
+    only = [s for s in args.only.split(",") if s] or [*CASES, "first-episode"]
+    unknown = set(only) - {*CASES, "first-episode"}
+    if unknown:
+        sys.exit(f"unknown rows: {', '.join(sorted(unknown))}")
+    print(f"load average before: {os.getloadavg()[0]:.2f}   runs: {args.runs}   python: {sys.version.split()[0]}   "
+          f"root: {ROOT}")
+    print(f"{'row':<26}{'min s':>8}{'median s':>10}{'max s':>8}{'CPU s':>8}{'goal s':>8}  ok")
+    rows = []
+    for label in only:
+        if label == "first-episode":
+            rows += _first_episode(args.runs)
+            continue
+        argv, goal = CASES[label]
+        _timed(argv)  # warm-up
+        samples = [_timed(argv)[:2] for _ in range(args.runs)]
+        rows.append(_row(label, [w for w, _ in samples], [c for _, c in samples], goal))
+    load = os.getloadavg()[0]
+    print(f"load average after: {load:.2f}")
+    if args.json is not None:
+        args.json.write_text(json.dumps({"rows": rows, "runs": args.runs, "load_after": load}, indent=2) + "\n")
 
 
 if __name__ == "__main__":

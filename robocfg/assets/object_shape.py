@@ -21,16 +21,19 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
-import trimesh
 
+from robocfg.assets.mesh_part import MeshPart
 from robocfg.assets.paths import body_asset
 from robocfg.assets.urdf import Geometry
 from robocfg.assets.urdf_xml import parse_urdf, read_urdf_xml
 from robocfg.config.scene import Body
 from robocfg.geometry import rpy_matrix
+
+if TYPE_CHECKING:
+    import trimesh
 
 FINGER_CLEARANCE = 0.004  # m: free gap left on each side of an object between open fingers
 SECTIONS = 16  # facets of a cylinder/capsule/sphere approximation (points on hulls, not for physics)
@@ -43,7 +46,7 @@ class ObjectShape:
     ``symmetry``: "spherical" (a sphere: every orientation alike), "axial" (cylinder, capsule:
     turns about the body's z axis alike) or "none"."""
 
-    parts: tuple[trimesh.Trimesh, ...]
+    parts: tuple[MeshPart, ...]
     file_mass: float | None = None
     symmetry: Literal["none", "axial", "spherical"] = "none"
 
@@ -144,25 +147,34 @@ def object_shape(body: Body, base_dir: Path) -> ObjectShape:
     paths (the task file's folder). Raises UnresolvedPath for a missing file, ValueError for a
     file that holds no usable geometry."""
     s = [float(v) for v in body.size]
-    if body.shape == "box":
-        return ObjectShape((trimesh.creation.box(extents=s),))
+    if body.shape == "box":  # no trimesh: the common case stays off its 0.3-1.5 s import
+        return ObjectShape((MeshPart.box(s),))
+    import trimesh
+
     if body.shape == "sphere":
-        return ObjectShape((trimesh.creation.icosphere(subdivisions=2, radius=s[0]),), symmetry="spherical")
+        return _shape((trimesh.creation.icosphere(subdivisions=2, radius=s[0]),), symmetry="spherical")
     if body.shape == "cylinder":
-        return ObjectShape((trimesh.creation.cylinder(radius=s[0], height=s[1], sections=SECTIONS),), symmetry="axial")
+        return _shape((trimesh.creation.cylinder(radius=s[0], height=s[1], sections=SECTIONS),), symmetry="axial")
     if body.shape == "capsule":
-        return ObjectShape((trimesh.creation.capsule(height=s[1], radius=s[0], count=[SECTIONS, SECTIONS]),),
-                           symmetry="axial")
+        return _shape((trimesh.creation.capsule(height=s[1], radius=s[0], count=[SECTIONS, SECTIONS]),),
+                      symmetry="axial")
     path = body_asset(body.mesh or "", base_dir)
     if path.suffix.lower() == ".urdf":
         return _urdf_shape(path, s[0])
-    return ObjectShape(_hulls(path, tuple(s)))
+    return _shape(_hulls(path, tuple(s)))
+
+
+def _shape(parts: tuple[trimesh.Trimesh, ...], file_mass: float | None = None,
+           symmetry: Literal["none", "axial", "spherical"] = "none") -> ObjectShape:
+    return ObjectShape(tuple(MeshPart.of(p) for p in parts), file_mass, symmetry)
 
 
 @lru_cache(maxsize=64)
 def _hulls(path: Path, scale: tuple[float, float, float]) -> tuple[trimesh.Trimesh, ...]:
     """Convex hull of each connected part of the mesh file, scaled (a VHACD file's parts are its
     convex pieces; a single-part mesh collides as its hull in PyBullet)."""
+    import trimesh
+
     mesh = trimesh.load(str(path), force="mesh", process=False)
     if not isinstance(mesh, trimesh.Trimesh) or not len(mesh.vertices):
         raise ValueError(f"{path}: no mesh that trimesh can read")
@@ -174,6 +186,8 @@ def _hulls(path: Path, scale: tuple[float, float, float]) -> tuple[trimesh.Trime
 
 
 def _hull(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    import trimesh
+
     try:
         return mesh.convex_hull
     except Exception:  # flat or degenerate part (qhull refuses): keep its bounding box
@@ -199,10 +213,12 @@ def _urdf_shape(path: Path, scaling: float) -> ObjectShape:
         part.apply_transform(np.linalg.inv(com))  # into the inertial frame PyBullet reports
         part.apply_scale(scaling)
         out.append(part)
-    return ObjectShape(tuple(out), link.mass)
+    return _shape(tuple(out), link.mass)
 
 
 def _geometry_parts(geom: Geometry, urdf_path: Path) -> tuple[trimesh.Trimesh, ...]:
+    import trimesh
+
     if geom.kind == "mesh":
         mesh_path = (urdf_path.parent / (geom.filename or "")).resolve()
         return _hulls(mesh_path, tuple(float(v) for v in geom.scale))

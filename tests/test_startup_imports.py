@@ -1,0 +1,98 @@
+"""What a fresh robocfg process imports: the libraries a command does not need stay unloaded
+(`robocfg --help`, `robocfg run pick-place --help`, `robocfg validate`, a pick-place process up to
+its world), read from ``sys.modules`` when the real command exits. A behaviour check of the
+start-up work (benchmarks/bench_startup.py measures its time; no wall-clock assert here)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# never needed before an episode of a state-only pick-place run, nor by help or validate
+NEVER = ["ray", "pyarrow", "av", "h5py", "ompl", "toppra", "matplotlib", "imageio", "trimesh", "networkx",
+         "gymnasium", "viser", "placo", "pink", "yourdfpy", "PIL"]
+
+
+def _imported(tmp_path: Path, cli: list[str] | None = None, code: str | None = None) -> set[str]:
+    """Every module in ``sys.modules`` when a fresh ``robocfg CLI...`` process (or ``python -c
+    CODE``) exits, run in the repository root."""
+    out_file = tmp_path / "modules.txt"
+    probe = (f"import atexit, sys; atexit.register(lambda: open({str(out_file)!r}, 'w').write(chr(10).join(sys.modules)))\n")
+    if cli is not None:
+        probe += f"import runpy; sys.argv = ['robocfg', *{cli!r}]; runpy.run_module('robocfg', run_name='__main__')\n"
+    else:
+        probe += f"{code}\n"
+    out = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return set(out_file.read_text().split())
+
+
+def _heavy(names: set[str], heavy: list[str]) -> list[str]:
+    return sorted(h for h in heavy if any(n == h or n.startswith(h + ".") for n in names))
+
+
+def test_root_help_imports_no_numpy_pydantic_or_simulator(tmp_path) -> None:
+    names = _imported(tmp_path, ["--help"])
+    assert "robocfg.cli.validate" in names  # the probe sees the command's modules
+    assert _heavy(names, [*NEVER, "numpy", "pydantic", "scipy", "pybullet", "pinocchio", "rich"]) == []
+
+
+def test_run_kind_help_imports_no_simulator_kinematics_or_scipy(tmp_path) -> None:
+    names = _imported(tmp_path, ["run", "pick-place", "--help"])
+    assert "robocfg.runners.pick_place" in names  # the kind's options come from its runner
+    assert _heavy(names, [*NEVER, "scipy", "pybullet", "pinocchio"]) == []
+
+
+def test_validating_a_pick_place_of_a_box_imports_no_trimesh(tmp_path) -> None:
+    names = _imported(tmp_path, ["validate", "robocfg/data/tasks/pick_place.yaml"])
+    assert "robocfg.checks.grip_force" in names  # the checks that measure the object ran
+    assert _heavy(names, [*NEVER, "pybullet"]) == []
+
+
+def test_a_pick_place_process_up_to_its_world_imports_only_what_it_runs(tmp_path) -> None:
+    code = ("from robocfg.checks.task import load_task; from robocfg.config import catalog; "
+            "from robocfg.engine import RunOptions, open_session; "
+            "open_session(load_task(catalog.find('tasks', 'pick_place')), RunOptions(seed=0)).close()")
+    names = _imported(tmp_path, code=code)
+    assert {"pybullet", "pinocchio"} <= names  # the probe sees the world being built
+    assert _heavy(names, NEVER) == []
+
+
+def test_a_mesh_object_still_loads_trimesh_on_demand() -> None:
+    from robocfg.assets.object_shape import object_shape
+    from robocfg.config.scene import Body
+
+    shape = object_shape(Body(name="ball", shape="sphere", size=[0.03]), ROOT)
+    assert shape.extents() == pytest.approx([0.06, 0.06, 0.06], abs=1e-9)
+
+
+@pytest.mark.parametrize("extents", [[0.05, 0.05, 0.05], [0.04, 0.06, 0.08], [0.3, 0.02, 0.11]])
+def test_box_part_is_trimesh_box_bit_for_bit(extents) -> None:
+    """The box built without trimesh has trimesh's vertices, faces, normals and face areas, so
+    the surface samples and grasp choices of a box object are the ones trimesh gave."""
+    import trimesh
+
+    from robocfg.assets.mesh_part import MeshPart
+
+    theirs, ours = trimesh.creation.box(extents=extents), MeshPart.box(extents)
+    for name in ("vertices", "faces", "face_normals", "triangles", "area_faces"):
+        a, b = np.asarray(getattr(theirs, name)), getattr(ours, name)
+        assert a.dtype == b.dtype and np.array_equal(a, b), name
+    assert ours.area == theirs.area
+
+
+def test_converted_part_keeps_trimesh_areas() -> None:
+    import trimesh
+
+    from robocfg.assets.mesh_part import MeshPart
+
+    theirs = trimesh.creation.capsule(height=0.05, radius=0.02, count=[16, 16])
+    ours = MeshPart.of(theirs)
+    assert np.array_equal(ours.area_faces, theirs.area_faces) and ours.area == theirs.area
+    assert np.array_equal(ours.face_normals, theirs.face_normals)
