@@ -99,3 +99,18 @@ def test_quat_to_matrix_gives_scipys_bits_for_one_quaternion():
     assert np.array_equal(quat_to_matrix(qs[:5]), Rotation.from_quat(qs[:5]).as_matrix())
     with pytest.raises(ValueError):
         quat_to_matrix([0.0, 0.0, 0.0, 0.0])
+
+
+def test_euler_deg_to_quat_gives_scipys_bits():
+    """The closed form is scipy's arithmetic: the same bits (signed zeros included), so task
+    poses, simulated runs and golden reports do not change with it."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(5)
+    angles = np.vstack([rng.uniform(-400.0, 400.0, size=(3000, 3)), rng.integers(-4, 5, size=(500, 3)) * 45.0,
+                        [[0.0, 0.0, 0.0], [-0.0, 0.0, -0.0], [180.0, 90.0, -90.0]]])
+    for rpy in angles:
+        ours = np.array(euler_deg_to_quat_xyzw(list(rpy)))
+        theirs = Rotation.from_euler("xyz", rpy, degrees=True).as_quat()
+        assert ours.tobytes() == theirs.tobytes(), rpy
+    assert all(type(v) is float for v in euler_deg_to_quat_xyzw([10, 20, 30]))

@@ -55,13 +55,17 @@ def test_validating_a_pick_place_of_a_box_imports_no_trimesh(tmp_path) -> None:
     assert _heavy(names, [*NEVER, "pybullet"]) == []
 
 
-def test_a_pick_place_process_up_to_its_world_imports_only_what_it_runs(tmp_path) -> None:
+def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp_path) -> None:
+    """The fixed start of every process (a pool worker, a Ray actor, ``robocfg run``): no
+    scipy.interpolate (splines are robocfg.motion.cubic), no scipy.spatial (rotations in closed
+    form), no trimesh (a box's shape without it)."""
     code = ("from robocfg.checks.task import load_task; from robocfg.config import catalog; "
             "from robocfg.engine import RunOptions, open_session; "
-            "open_session(load_task(catalog.find('tasks', 'pick_place')), RunOptions(seed=0)).close()")
+            "s = open_session(load_task(catalog.find('tasks', 'pick_place')), RunOptions(seed=0)); "
+            "assert s.run(0).success; s.close()")
     names = _imported(tmp_path, code=code)
-    assert {"pybullet", "pinocchio"} <= names  # the probe sees the world being built
-    assert _heavy(names, NEVER) == []
+    assert {"pybullet", "pinocchio", "robocfg.motion.cubic"} <= names  # the probe sees the episode's modules
+    assert _heavy(names, [*NEVER, "scipy.interpolate", "scipy.spatial", "scipy.optimize", "scipy.sparse"]) == []
 
 
 def test_a_mesh_object_still_loads_trimesh_on_demand() -> None:

@@ -4,11 +4,12 @@ Quaternions are ``(x, y, z, w)``; roll-pitch-yaw angles are extrinsic X-Y-Z (``R
 the convention of URDF ``rpy`` and of PyBullet's ``getQuaternionFromEuler``. Matrices are 3x3
 numpy arrays (float64).
 
-scipy is imported inside the functions, and the two conversions that URDF parsing and URDF
-forward kinematics need (:func:`rpy_matrix`, :func:`axis_angle_matrix`) are closed forms in
-numpy: ``robocfg validate`` parses every robot's URDF, and importing ``scipy.spatial`` costs
-about 0.3 s of CPU, more than half of what validating the built-in robots takes. Both closed
-forms are tested against scipy's ``Rotation``.
+scipy is imported inside the functions, and the conversions that URDF parsing, URDF forward
+kinematics and task poses need (:func:`rpy_matrix`, :func:`axis_angle_matrix`,
+:func:`euler_deg_to_quat_xyzw`, one :func:`quat_to_matrix`) are closed forms: ``robocfg
+validate`` parses every robot's URDF and every process reads task poses, and importing
+``scipy.spatial`` costs about 0.3 s of CPU, more than half of what validating the built-in
+robots takes. The closed forms are tested against scipy's ``Rotation``.
 """
 
 from __future__ import annotations
@@ -49,11 +50,27 @@ def matrix_to_quat(R: np.ndarray) -> np.ndarray:
 
 
 def euler_deg_to_quat_xyzw(rpy_deg: Sequence[float]) -> tuple[float, float, float, float]:
-    """Roll, pitch, yaw in degrees (``R = Rz·Ry·Rx``) to a unit quaternion ``(x, y, z, w)``."""
-    from scipy.spatial.transform import Rotation
+    """Roll, pitch, yaw in degrees (``R = Rz·Ry·Rx``) to a unit quaternion ``(x, y, z, w)``.
 
-    x, y, z, w = Rotation.from_euler("xyz", np.asarray(rpy_deg, dtype=float), degrees=True).as_quat()
-    return (float(x), float(y), float(z), float(w))
+    In closed form with scipy's own arithmetic (elementary quaternions composed z·(y·x) as
+    ``Rotation.from_euler("xyz", ..., degrees=True).as_quat()`` does; the same bits, tested): every
+    task body's pose goes through here, and importing ``scipy.spatial`` costs a fresh process
+    0.2–1 s."""
+    r, p, y = (float(v) * (math.pi / 180.0) for v in rpy_deg)
+    qx = (math.sin(r / 2.0), 0.0, 0.0, math.cos(r / 2.0))
+    qy = (0.0, math.sin(p / 2.0), 0.0, math.cos(p / 2.0))
+    qz = (0.0, 0.0, math.sin(y / 2.0), math.cos(y / 2.0))
+    return _compose_quat(qz, _compose_quat(qy, qx))
+
+
+def _compose_quat(p: tuple[float, float, float, float],
+                  q: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    """The quaternion product p·q, term for term in scipy's order (``_compose_quat_single``)."""
+    c0 = p[1] * q[2] - p[2] * q[1]
+    c1 = p[2] * q[0] - p[0] * q[2]
+    c2 = p[0] * q[1] - p[1] * q[0]
+    return (p[3] * q[0] + q[3] * p[0] + c0, p[3] * q[1] + q[3] * p[1] + c1, p[3] * q[2] + q[3] * p[2] + c2,
+            p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2])
 
 
 def rpy_matrix(r: float, p: float, y: float) -> np.ndarray:

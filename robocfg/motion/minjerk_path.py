@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from robocfg.motion.cubic import CubicSpline  # scipy's bits without importing scipy.interpolate
 from robocfg.motion.limits import JointLimits
 from robocfg.motion.trajectory import Trajectory
 
@@ -51,12 +52,11 @@ class MinJerkPath(Trajectory):
         else:
             seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
         self.waypoints = W
+        self.spline: _Segment | CubicSpline
         if len(W) == 2:  # a straight segment: linear in s
             self.spline = _Segment(W)
             d1, d2 = np.abs(W[1] - W[0]), np.zeros(W.shape[1])
         else:
-            from scipy.interpolate import CubicSpline
-
             knots = np.concatenate([[0.0], np.cumsum(seg)])
             knots /= knots[-1]
             self.spline = CubicSpline(knots, W, axis=0, bc_type="not-a-knot" if len(W) > 3 else "natural")

@@ -1,0 +1,104 @@
+"""scipy's ``CubicSpline`` (not-a-knot and natural ends) without importing ``scipy.interpolate``.
+
+Importing ``scipy.interpolate`` pulls in ``scipy.optimize``, ``scipy.sparse``, ``scipy.special`` and
+``scipy.spatial``: 0.2–1 s of a fresh process, paid by the first pick-place episode of every
+process (its straight moves are splines through many waypoints). :class:`CubicSpline` here does
+the same arithmetic in the same order — the tridiagonal system solved by LAPACK ``dgtsv`` as
+``scipy.linalg.solve_banded`` does, the Hermite coefficients, and ``PPoly``'s evaluation loop
+(``_ppoly.evaluate_poly1``: Horner-free powers, derivative prefactors) — so its values are the
+same bits as scipy's (tested against ``scipy.interpolate.CubicSpline``), and simulated runs do
+not change with it. ``scipy.linalg`` is imported (the IK already needs it).
+
+Only what robocfg calls: ``x`` (k,) strictly increasing, ``y`` (k, n) along axis 0, k ≥ 4 for
+``"not-a-knot"`` and k ≥ 2 for ``"natural"``; ``spline(s, nu)`` for ``nu`` in 0, 1, 2, 3,
+extrapolating the end pieces like scipy. Units: whatever ``x`` and ``y`` carry.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+
+
+class CubicSpline:
+    """A C² cubic through ``(x[i], y[i])``: ``spline(s)``, ``spline(s, nu)`` → (len(s), n)."""
+
+    def __init__(self, x, y, axis: int = 0, bc_type: Literal["not-a-knot", "natural"] = "not-a-knot"):
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        if axis != 0 or y.ndim != 2 or x.ndim != 1 or len(x) != len(y):
+            raise ValueError("CubicSpline: x (k,) and y (k, n) along axis 0 only")
+        if bc_type not in ("not-a-knot", "natural") or len(x) < (4 if bc_type == "not-a-knot" else 2):
+            raise ValueError(f"CubicSpline: {bc_type!r} ends with {len(x)} points are not supported here")
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+            raise ValueError("CubicSpline: x and y must be finite")
+        dx = np.diff(x)
+        if np.any(dx <= 0):
+            raise ValueError("CubicSpline: x must be strictly increasing")
+        n = len(x)
+        dxr = dx.reshape(len(dx), 1)
+        slope = np.diff(y, axis=0) / dxr
+        A = np.zeros((3, n))  # banded: upper, diagonal, lower
+        b = np.empty((n, y.shape[1]), dtype=np.float64)
+        A[1, 1:-1] = 2 * (dx[:-1] + dx[1:])
+        A[0, 2:] = dx[:-1]
+        A[-1, :-2] = dx[1:]
+        b[1:-1] = 3 * (dxr[1:] * slope[:-1] + dxr[:-1] * slope[1:])
+        if bc_type == "not-a-knot":
+            A[1, 0] = dx[1]
+            A[0, 1] = x[2] - x[0]
+            d = x[2] - x[0]
+            b[0] = ((dxr[0] + 2 * d) * dxr[1] * slope[0] + dxr[0] ** 2 * slope[1]) / d
+            A[1, -1] = dx[-2]
+            A[-1, -2] = x[-1] - x[-3]
+            d = x[-1] - x[-3]
+            b[-1] = (dxr[-1] ** 2 * slope[-2] + (2 * d + dxr[-1]) * dxr[-2] * slope[-1]) / d
+        else:  # natural: second derivative 0 at both ends (scipy's (2, 0.0) conditions)
+            zero = np.zeros(y.shape[1])
+            A[1, 0] = 2 * dx[0]
+            A[0, 1] = dx[0]
+            b[0] = -0.5 * zero * dx[0] ** 2 + 3 * (y[1] - y[0])
+            A[1, -1] = 2 * dx[-1]
+            A[-1, -2] = dx[-1]
+            b[-1] = 0.5 * zero * dx[-1] ** 2 + 3 * (y[-1] - y[-2])
+        s = _solve_tridiagonal(A, b)
+        t = (s[:-1] + s[1:] - 2 * slope) / dxr
+        self.x = x
+        self.c = np.stack((t / dxr, (slope - s[:-1]) / dxr - t, s[:-1], y[:-1]))  # (4, k-1, n), highest power first
+
+    def __call__(self, xs, nu: int = 0) -> np.ndarray:
+        """Values (nu = 0) or the ``nu``-th derivative at ``xs``: shape ``xs.shape + (n,)``."""
+        xs = np.asarray(xs, dtype=np.float64)
+        flat = xs.ravel()
+        i = np.clip(np.searchsorted(self.x, flat, side="right") - 1, 0, len(self.x) - 2)
+        s = (flat - self.x[i])[:, None]
+        order = self.c.shape[0]
+        res: np.ndarray | None = None
+        z: np.ndarray | None = None  # s**(kp - nu); None stands for scipy's exact 1.0
+        for kp in range(nu, order):
+            prefactor = 1.0
+            for k in range(kp, kp - nu, -1):
+                prefactor *= k
+            term = self.c[order - kp - 1][i]  # scipy: res = res + c * z * prefactor (x * 1.0 is x, bit for bit)
+            if z is not None:
+                term = term * z
+            if prefactor != 1.0:
+                term = term * prefactor
+            res = term + 0.0 if res is None else res + term  # scipy starts from res = 0.0
+            if kp < order - 1:
+                z = s if z is None else z * s
+        if res is None:
+            res = np.zeros((len(flat), self.c.shape[2]))
+        res[np.isnan(flat)] = np.nan  # scipy: NaN in, NaN out (every derivative)
+        return res.reshape(*xs.shape, self.c.shape[2])
+
+
+def _solve_tridiagonal(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``scipy.linalg.solve_banded((1, 1), A, b)`` as scipy calls it: LAPACK ``dgtsv``."""
+    from scipy.linalg.lapack import dgtsv
+
+    _, _, _, x, info = dgtsv(A[2, :-1], A[1, :], A[0, 1:], b, 1, 1, 1, 1)
+    if info != 0:
+        raise np.linalg.LinAlgError("CubicSpline: singular system")
+    return x
