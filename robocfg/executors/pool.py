@@ -47,6 +47,7 @@ def _worker_main(conn: Connection, recipe: Recipe) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         session = recipe.open()
+        conn.send(("ready", None))  # the world is built: what ProcessPool.start waits for
         try:
             while (msg := conn.recv()) is not None:
                 if isinstance(msg, ReportRequest):
@@ -68,6 +69,7 @@ class _Worker:
     conn: Connection
     batch: Batch | None = None
     finished: int = 0  # episodes of the current batch reported so far
+    ready: bool = False  # its session is open
 
 
 class ProcessPool:
@@ -78,22 +80,57 @@ class ProcessPool:
             raise RobocfgError(f"--workers {workers}: need at least 1")
         self.workers = workers
         self.pids: list[int] = []  # the worker processes' ids, once started
+        self._started: tuple[Recipe, list[_Worker]] | None = None
+
+    def start(self, recipe: Recipe) -> None:
+        """Start the workers for ``recipe`` and wait until each has built its world (or died):
+        the fixed start of a run, which the next :meth:`run` of the same recipe then skips (a
+        benchmark times it apart from the episodes). Optional: ``run`` starts them itself."""
+        pool = self._spawn(recipe, self.workers)
+        self._started = (recipe, pool)
+        try:
+            for w in pool:
+                while not w.ready:
+                    ready = wait([w.conn, w.process.sentinel])
+                    if w.conn not in ready or not w.conn.poll():
+                        break  # died while opening: run() reports what it had to do as lost
+                    msg = w.conn.recv()
+                    if msg[0] == "error":
+                        raise WorkerError(f"worker {w.process.pid} failed: {msg[1]}\n{msg[2]}")
+                    w.ready = msg[0] == "ready"
+        except BaseException:
+            self._started = None
+            for w in pool:
+                self._stop(w)
+            raise
+
+    def _spawn(self, recipe: Recipe, count: int) -> list[_Worker]:
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["robocfg.executors.boot", "robocfg.executors.pool", *recipe.preload])
+        pool: list[_Worker] = []
+        for _ in range(count):
+            parent, child = ctx.Pipe()
+            proc = ctx.Process(target=_worker_main, args=(child, recipe), daemon=True)
+            proc.start()
+            child.close()
+            pool.append(_Worker(proc, parent))
+        self.pids = [w.process.pid for w in pool]
+        return pool
 
     def run(self, recipe: Recipe, batches: list[Batch], on_episode: Callable[[EpisodeRun], None] | None = None,
             should_stop: Callable[[], bool] | None = None) -> Execution:
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["robocfg.executors.boot", "robocfg.executors.pool", *recipe.preload])
+        """Run ``batches`` on the workers :meth:`start` started for this recipe, else on new ones;
+        the workers stop when it returns."""
         todo = deque(batches)
-        result = Execution(workers=min(self.workers, len(batches)) or 1)
+        started, self._started = self._started, None
         pool: list[_Worker] = []
+        if started is not None and started[0] is not recipe:
+            for w in started[1]:
+                self._stop(w)
+            started = None
+        result = Execution(workers=len(started[1]) if started is not None else min(self.workers, len(batches)) or 1)
         try:
-            for _ in range(result.workers):
-                parent, child = ctx.Pipe()
-                proc = ctx.Process(target=_worker_main, args=(child, recipe), daemon=True)
-                proc.start()
-                child.close()
-                pool.append(_Worker(proc, parent))
-            self.pids = [w.process.pid for w in pool]
+            pool = started[1] if started is not None else self._spawn(recipe, result.workers)
             for w in pool:
                 self._hand_out(w, todo)
             while any(w.batch is not None for w in pool):
@@ -126,6 +163,8 @@ class ProcessPool:
                 ready = wait([w.conn, w.process.sentinel])
                 if w.conn in ready and w.conn.poll():
                     msg = w.conn.recv()
+                    while msg[0] == "ready":  # an idle worker's first message, never read before
+                        msg = w.conn.recv()
                     if msg[0] == "report":
                         return msg[1]
                     if msg[0] == "error":
@@ -152,7 +191,9 @@ class ProcessPool:
                 msg = w.conn.recv()
             except (EOFError, OSError):
                 break
-            if msg[0] == "episode":
+            if msg[0] == "ready":
+                w.ready = True
+            elif msg[0] == "episode":
                 w.finished += 1
                 if on_episode is not None:
                     on_episode(msg[1])

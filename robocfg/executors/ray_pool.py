@@ -61,23 +61,55 @@ class RayPool:
             raise RobocfgError(f"--workers {workers}: need at least 1")
         self.workers, self.address = workers, address
         self.actors: list[Any] = []
+        self._started: tuple[Recipe, bool] | None = None  # the actors' recipe, and whether Ray was started here
+
+    def start(self, recipe: Recipe) -> None:
+        """Start the actors for ``recipe`` and wait until each has built its world: the fixed start
+        of a run (a fresh interpreter per actor), which the next :meth:`run` of the same recipe then
+        skips (a benchmark times it apart from the episodes). Optional: ``run`` starts them itself."""
+        ray = _ray()
+        from ray.exceptions import RayActorError
+
+        started = _init(ray, self.address)
+        self._start_actors(ray, recipe, self.workers)
+        self._started = (recipe, started)
+        try:
+            ray.get([a.pid.remote() for a in self.actors])
+        except RayActorError as exc:
+            self._started = None
+            self._stop(ray, started)
+            raise WorkerError(f"a Ray actor could not start: {_first_line(exc)}") from exc
+
+    def _start_actors(self, ray: Any, recipe: Recipe, count: int) -> None:
+        remote = ray.remote(num_cpus=1, max_restarts=0)(_Actor)
+        self.actors = [remote.remote(recipe) for _ in range(count)]
+
+    def _stop(self, ray: Any, shutdown: bool) -> None:
+        for a in self.actors:
+            ray.kill(a)
+        self.actors = []
+        if shutdown:
+            ray.shutdown()
 
     def run(self, recipe: Recipe, batches: list[Batch], on_episode: Callable[[EpisodeRun], None] | None = None,
             should_stop: Callable[[], bool] | None = None) -> Execution:
-        try:
-            import ray
-            from ray.exceptions import RayActorError, RayTaskError
-        except ImportError as exc:
-            raise RobocfgError("--executor ray needs Ray: pip install 'robocfg[ray]'") from exc
-        started = False
-        if not ray.is_initialized():
-            address = self.address or os.environ.get("RAY_ADDRESS") or None
-            ray.init(address=address, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False)
-            started = True
-        result = Execution(workers=min(self.workers, len(batches)) or 1)
+        """Run ``batches`` on the actors :meth:`start` started for this recipe, else on new ones
+        (one per worker, each kept for all the batches); the actors end when it returns."""
+        ray = _ray()
+        from ray.exceptions import RayActorError, RayTaskError
+
+        prior, self._started = self._started, None
+        if prior is not None and prior[0] is not recipe:
+            self._stop(ray, prior[1])
+            prior = None
+        if prior is not None:
+            started = prior[1]
+            result = Execution(workers=len(self.actors))
+        else:
+            started = _init(ray, self.address)
+            result = Execution(workers=min(self.workers, len(batches)) or 1)
+            self._start_actors(ray, recipe, result.workers)
         todo = deque(batches)
-        remote = ray.remote(num_cpus=1, max_restarts=0)(_Actor)
-        self.actors = [remote.remote(recipe) for _ in range(result.workers)]
         inflight: dict[Any, tuple[Any, Batch]] = {}
 
         def hand_out(actor: Any) -> None:
@@ -112,11 +144,26 @@ class RayPool:
                 result.lost.append(LostEpisodes(batch.indices, "no Ray actor left to run it"))
             result.report = _report_of(ray, self.actors, recipe, result)
         finally:
-            for a in self.actors:
-                ray.kill(a)
-            if started:
-                ray.shutdown()
+            self._stop(ray, started)
         return result
+
+
+def _ray() -> Any:
+    try:
+        import ray
+    except ImportError as exc:
+        raise RobocfgError("--executor ray needs Ray: pip install 'robocfg[ray]'") from exc
+    return ray
+
+
+def _init(ray: Any, address: str | None) -> bool:
+    """Connect to Ray unless this process already is; True when Ray was started here (and is to be
+    shut down after the run)."""
+    if ray.is_initialized():
+        return False
+    address = address or os.environ.get("RAY_ADDRESS") or None
+    ray.init(address=address, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False)
+    return True
 
 
 def _report_of(ray: Any, actors: list[Any], recipe: Recipe, result: Execution) -> Any:
