@@ -3,9 +3,11 @@ the arm of a robot that cannot reach them (scaled about its arm base by the rati
 and left alone for a robot that reaches them."""
 
 import numpy as np
+import pytest
 
 from robocfg.checks import load_task
 from robocfg.config import catalog
+from robocfg.geometry import pose_matrix
 from robocfg.runners.follow_target import placed_params
 from robocfg.runners.trajectory import plan_task, run_trajectory
 
@@ -48,3 +50,27 @@ def test_follow_target_motion_and_obstacles_scale_about_the_arm_base():
         np.testing.assert_allclose(a.size, np.asarray(b.size) * k, atol=1e-9)
     same, none = placed_params(load_task(catalog.find("tasks", "follow_target")), None, given)
     assert none == "" and same == given
+
+
+def test_auto_steps_the_scale_down_until_every_mapped_point_is_reached(monkeypatch):
+    """An arm whose reach along the ray is not one interval (the drafted Z1 reaches 0.2-0.3 m and
+    0.8 m out along the default trajectory's direction, not 0.35-0.75 m): the reach ratio would put
+    the waypoint in the gap; the scale steps down to the largest that IK reaches."""
+    from robocfg.motion import relative
+
+    task = load_task(catalog.find("tasks", "trajectory"), robot_override="ur5e_robotiq_2f85")
+    (pose,) = [w for w in task.config.trajectory.waypoints if not isinstance(w, str)]
+    given = np.asarray(pose.position)  # 0.70 m from the base
+
+    def reaches(model, robot, arm, T):
+        d = float(np.linalg.norm(T[:3, 3]))  # both arm bases sit at the origin
+        return d <= 0.3 or d >= 0.8
+
+    monkeypatch.setattr(relative, "_reaches", reaches)
+    monkeypatch.setattr(relative, "_reach", lambda model, robot, *a: 0.86 if robot.config.name == "panda" else 0.826)
+    m = relative.auto_map(task, None, [pose_matrix(pose)], "Cartesian waypoints")
+    assert m is not None
+    d = np.linalg.norm(m.point(given))
+    assert d <= 0.3  # x0.4 of the ratio 0.96: the largest step that lands where the arm reaches
+    assert m.scale == pytest.approx(0.826 / 0.86 * 0.4)
+    assert "x0.4 of 0.96" in m.note

@@ -11,6 +11,13 @@ which IK reaches the TCP with the tool orientation of the first point). Lengths 
 sizes) are scaled by ``k``. A desk arm's points thus land where a KR 210 on the floor, or an arm
 mounted high on a torso lift, works.
 
+The mapped points are checked too: an arm's reachable set along a ray is not always one interval
+(the drafted Unitree Z1 with its tool pointing down reaches 0.2-0.3 m and 0.8 m along the default
+trajectory's direction, not 0.35-0.75 m), and along a ray the arm reaches nowhere there is no
+ratio at all (then 1). When some mapped point is out of IK reach, ``k`` steps down (``SHRINK``
+times the ratio) until every point is reached; when none works the points are left for the run
+to report unreachable.
+
 Frames: world, metres.
 """
 
@@ -28,6 +35,7 @@ from robocfg.motion.placement import farthest_reachable
 
 FK_SAMPLES = 400  # random configurations bounding how far the TCP can get from the arm base
 IK_BUDGET = 0.2  # s per IK query; not consulted: bound_ik_by_iterations ends the search by count
+SHRINK = (1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3)  # fractions of the reach ratio tried, largest first
 
 
 @dataclass(frozen=True)
@@ -68,13 +76,27 @@ def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: 
     R = poses[0][:3, :3]
     r_theirs = _reach(theirs, theirs_robot, None, b_theirs, direction, R)
     r_ours = _reach(ours, ours_robot, arm, b_ours, direction, R)
-    if r_theirs <= 0.0 or r_ours <= 0.0:
-        return None
-    k = r_ours / r_theirs
-    note = (f"placement auto: {what} moved to {ours_robot.config.name}'s arm (reach {r_ours:.2f} m, the task's robot "
-            f"{theirs_robot.config.name}: {r_theirs:.2f} m): scaled x{k:.2f} about its base at "
-            f"[{b_ours[0]:.3f}, {b_ours[1]:.3f}, {b_ours[2]:.3f}] m")
-    return PointMap(b_theirs, b_ours, k, note)
+    measured = r_theirs > 0.0 and r_ours > 0.0
+    ratio = r_ours / r_theirs if measured else 1.0
+    for f in SHRINK:
+        m = PointMap(b_theirs, b_ours, ratio * f, "")
+        if all(_reaches(ours, ours_robot, arm, _moved(T, m)) for T in poses):
+            break
+    else:
+        return None  # no scale reaches them all: the run names the unreachable points
+    how = (f"reach {r_ours:.2f} m, the task's robot {theirs_robot.config.name}: {r_theirs:.2f} m" if measured
+           else "no reach measured along the points' direction")
+    how += "" if f == 1.0 else f"; x{f:.1f} of {ratio:.2f}, the largest step at which IK reaches every point"
+    note = (f"placement auto: {what} moved to {ours_robot.config.name}'s arm ({how}): scaled x{m.scale:.2f} about its "
+            f"base at [{b_ours[0]:.3f}, {b_ours[1]:.3f}, {b_ours[2]:.3f}] m")
+    return PointMap(b_theirs, b_ours, m.scale, note)
+
+
+def _moved(T: np.ndarray, m: PointMap) -> np.ndarray:
+    """``T`` with its position mapped by ``m``."""
+    out = T.copy()
+    out[:3, 3] = m.point(T[:3, 3])
+    return out
 
 
 def _model(task: CheckedTask, robot: CheckedRobot, arm: str | None):
