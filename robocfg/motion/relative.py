@@ -95,7 +95,7 @@ def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: 
 def _moved(T: np.ndarray, m: PointMap) -> np.ndarray:
     """``T`` with its position mapped by ``m``."""
     out = T.copy()
-    out[:3, 3] = m.point(T[:3, 3])
+    out[:3, 3] = m.to + m.scale * (T[:3, 3] - m.origin)
     return out
 
 
