@@ -19,7 +19,7 @@ Frames: world, metres; grasps in the GraspNet convention (x approach, y closing)
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,6 +85,13 @@ def top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> list[list[Grasp]]:
     """Top-down grasps grouped by closing direction (each group: the two half-turn twins), best
     direction first; empty when no horizontal direction is narrow enough or the fingers cannot
     reach below the top without their palm touching it."""
+    return list(iter_top_down_groups(obj, boxes))
+
+
+def iter_top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> Iterator[list[Grasp]]:
+    """:func:`top_down_groups` one group at a time: a direction's grasp height (the costly part)
+    is searched only when its group is asked for (a choice that takes the first reachable group
+    seldom needs more than one)."""
     P = obj.points()
     rel = P[:, :2] - obj.position[:2]
     x_axis = obj.rotation[:, 0]
@@ -100,7 +107,6 @@ def top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> list[list[Grasp]]:
             continue
         mid = float(proj.max() + proj.min()) / 2
         options.append((round(width / SAME_WIDTH), order, a, width, mid))
-    groups = []
     fixed = _HeightCheck.of(obj) if options else None
     for _, _, a, width, mid in sorted(options):
         closing = np.array([math.cos(a), math.sin(a), 0.0])
@@ -109,8 +115,7 @@ def top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> list[list[Grasp]]:
             continue
         centre = np.array([obj.position[0] + mid * closing[0], obj.position[1] + mid * closing[1], z])
         down = np.array([0.0, 0.0, -1.0])
-        groups.append([Grasp(centre, grasp_rotation(down, s * closing), width) for s in (1.0, -1.0)])
-    return groups
+        yield [Grasp(centre, grasp_rotation(down, s * closing), width) for s in (1.0, -1.0)]
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ gripper, declared below, and is kept here because it is one concept of its own (
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,9 +21,9 @@ from robocfg.geometry import rotation_angle
 from robocfg.grasp.gripper_model import GripperBoxes
 from robocfg.grasp.object_grasp import (
     LyingObject,
+    iter_top_down_groups,
     mesh_grasps,
     suction_grasps,
-    top_down_groups,
     usable_width,
 )
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
@@ -55,11 +56,7 @@ class GraspChoice:
         IK when there are any; the smaller wrist turn breaks ties. (IK can land on a far branch for
         one of two half-turn twins, e.g. a Panda's shoulder flipped by ≈ 3 rad, or a wrist that
         must wind round a joint limit to carry.)"""
-        groups = self._grasp_groups(lying)
-        if not groups:
-            raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
-        R_now = self.arm.ee_pose()[:3, :3]
-        q0 = self.arm.joint_positions()
+        first: list[Grasp] | None = None
 
         def travel(g: Grasp) -> tuple[bool, float]:
             """(does a straight approach or lower line break, joint travel in rad); inf: unreachable."""
@@ -75,12 +72,18 @@ class GraspChoice:
                 broken = broken or not self._line_continuous(q, T_down)
             return broken, cost
 
-        for group in groups:
+        for group in self._iter_grasp_groups(lying):  # searched one at a time: usually the first will do
+            if first is None:
+                first = group
+                R_now = self.arm.ee_pose()[:3, :3]
+                q0 = self.arm.joint_positions()
             cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
             costs = [travel(g) for g in cands]
             if min(c for _, c in costs) < math.inf:
                 return cands[min(range(len(cands)), key=lambda i: costs[i])]
-        return groups[0][0]
+        if first is None:
+            raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
+        return first[0]
 
     def _line_continuous(self, q: np.ndarray, T_goal: np.ndarray) -> bool:
         """Whether the straight EE line from FK(``q``) down to ``T_goal`` (the approach, or the
@@ -94,20 +97,26 @@ class GraspChoice:
 
     def _grasp_groups(self, lying: LyingObject) -> list[list[Grasp]]:
         """Candidate grasps from the object's geometry, grouped, best group first."""
+        return list(self._iter_grasp_groups(lying))
+
+    def _iter_grasp_groups(self, lying: LyingObject) -> Iterator[list[Grasp]]:
+        """:meth:`_grasp_groups` one group at a time (a top-down group's height is searched when
+        it is asked for)."""
         p = self.params
         if self.gripper.grasps_at_surface:  # a cup touches the top face, pressing in slightly
-            return [suction_grasps(lying, SUCTION_PRESS)]
+            yield suction_grasps(lying, SUCTION_PRESS)
+            return
         if self.boxes is None:
             raise MoveFailed("grasp_choice", "the gripper's geometry was not measured")
-        groups = top_down_groups(lying, self.boxes)
-        if p.grasp_depth is not None:  # the task fixes the TCP height relative to the object's centre
-            z = float(lying.position[2]) + p.grasp_depth
-            groups = [[Grasp(np.array([*g.center[:2], z]), g.rotation, g.width) for g in grp] for grp in groups]
-        if self.setup.body.shape == "mesh":
+        if self.setup.body.shape == "mesh":  # drawn first, as before the top-down groups
             rng = np.random.default_rng([self.setup.seed, 1])
-            meshes = mesh_grasps(lying, self.boxes, rng, p.above_height)
-            groups = [[g, half_turn(g)] for g in meshes] + groups
-        return groups
+            for g in mesh_grasps(lying, self.boxes, rng, p.above_height):
+                yield [g, half_turn(g)]
+        for grp in iter_top_down_groups(lying, self.boxes):
+            if p.grasp_depth is not None:  # the task fixes the TCP height relative to the object's centre
+                z = float(lying.position[2]) + p.grasp_depth
+                grp = [Grasp(np.array([*g.center[:2], z]), g.rotation, g.width) for g in grp]
+            yield grp
 
     def _no_grasp_reason(self, lying: LyingObject) -> str:
         if self.boxes is None:
