@@ -33,3 +33,27 @@ def grasp_instruction(body) -> str:
 def trajectory_instruction(waypoints: int) -> str:
     """E.g. "move the arm through 4 waypoints"."""
     return f"move the arm through {waypoints} waypoints"
+
+
+def _listed(body) -> str:
+    """An object of several by its name, with its colour and shape where the name lacks them:
+    "the red box", "the mug"."""
+    name = body.name.replace("_", " ")
+    colour = colour_name(body.color) if getattr(body, "color", None) else ""
+    words = name.split()
+    if colour and colour not in words:
+        words.insert(0, colour)
+    if body.shape != "mesh" and body.shape not in words:
+        words.append(body.shape)
+    return "the " + " ".join(words)
+
+
+def pick_place_many_instruction(params, shelf: bool) -> str:
+    """E.g. "put the red box, the blue cylinder and the green box into bin_b" or, ``shelf`` (the
+    place fixture is a shelf), "... onto level 1 of shelf" (``params``: PickPlaceManyParams;
+    objects in the task's order)."""
+    names = [_listed(o) for o in params.objects]
+    listed = names[0] if len(names) == 1 else f"{', '.join(names[:-1])} and {names[-1]}"
+    place = params.place
+    where = f"onto level {place.level} of {place.fixture}" if shelf else f"into {place.fixture}"
+    return f"put {listed} {where}"

@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 from robocfg.config.types import AXIS_INDEX
 from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
 from robocfg.datasets.gate import CommandGate
+from robocfg.engine.dataset import EpisodeObjects, object_keys
 from robocfg.errors import RobocfgError
 
 
@@ -29,25 +30,27 @@ def steps_per_frame(dt: float, fps: float) -> int:
     return n
 
 
-def layout_names(arm, has_object: bool = True) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
+def layout_names(arm, objects: tuple[str, ...] = ("object",)) -> tuple[tuple[str, ...], tuple[str, ...], tuple[str, ...]]:
     """(state, env_state, action) entry names for ``arm`` (see :mod:`robocfg.datasets.episode`);
-    no env_state entries when the episodes have no object."""
+    ``objects``: the recorded objects' feature prefixes (``object``, or ``object.<name>`` each; none:
+    no env_state entries)."""
     grip = tuple(arm.robot.checked.gripper_joints(arm.config)) if arm.gripper is not None else ()
     joints = tuple(arm.joints) + grip
     state = (*(f"{j}.pos" for j in joints), *(f"{j}.vel" for j in joints),
              *(f"tcp.{k}" for k in ("x", "y", "z", "qx", "qy", "qz", "qw")), "gripper.opening")
-    env = tuple(f"object.{k}" for k in ("x", "y", "z", "qx", "qy", "qz", "qw")) if has_object else ()
+    env = tuple(f"{o}.{k}" for o in objects for k in ("x", "y", "z", "qx", "qy", "qz", "qw"))
     action = (*(f"{j}.target" for j in arm.joints), "gripper.command")
     return state, env, action
 
 
 class EpisodeRecorder:
-    """Frames of one episode of ``world`` (``arm`` acting, ``obj`` the object's body id, None:
-    no object); ``language``: the episode's instruction ("": the sink's)."""
+    """Frames of one episode of ``world`` (``arm`` acting, ``obj`` the object's body id, or several
+    objects' (name → id), None: no object); ``language``: the episode's instruction ("": the sink's)."""
 
-    def __init__(self, world, arm, obj: int | None, layout: DatasetLayout, rig, phase_of: Callable[[], str],
+    def __init__(self, world, arm, obj: EpisodeObjects, layout: DatasetLayout, rig, phase_of: Callable[[], str],
                  replay_actions: np.ndarray | None = None, language: str = ""):
-        self.world, self.arm, self.obj, self.layout, self.rig = world, arm, obj, layout, rig
+        self.world, self.arm, self.layout, self.rig = world, arm, layout, rig
+        self.objs = [bid for _, bid in object_keys(obj)]  # body ids, in the env_state's order
         self.phase_of, self.language = phase_of, language
         self.n = steps_per_frame(world.dt, layout.fps)
         self.gate = CommandGate(world, arm, self.n)
@@ -62,7 +65,7 @@ class EpisodeRecorder:
         self.qd: list[list[float]] = []  # their velocities
         self.opening: list[float] = []
         self.ee: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # ee_link world (position, quat x y z w)
-        self.obj_pose: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # object world (position, quat)
+        self.obj_pose: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # objects' world (position, quat), frame-major
         self.actions: list[np.ndarray] = []
         self.phases: list[int] = []
         self.images: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras}
@@ -108,8 +111,8 @@ class EpisodeRecorder:
         self.qd.append(qd)
         self.opening.append(arm.gripper.fraction() if arm.gripper is not None else 0.0)
         self.ee.append(r.link_position_quat(arm.config.ee_link))
-        if self.obj is not None:
-            self.obj_pose.append(self.world.body_pose_tuple(self.obj))
+        for bid in self.objs:
+            self.obj_pose.append(self.world.body_pose_tuple(bid))
         self.phases.append(self._phase_index.get(self.phase_of(), 0))
         if self.rig is not None and self.layout.cameras:
             for name, img in self.rig.render_all().items():
@@ -123,8 +126,8 @@ class EpisodeRecorder:
         return np.array([(*pos, *quat) for pos, quat in frames], dtype=float).reshape(-1, 7)
 
     def _in_base(self) -> tuple[np.ndarray, np.ndarray]:
-        """(T, 7) TCP and (T, 7 or 0) object poses in the robot base frame (position m, quaternion
-        x y z w), converted for all frames at once."""
+        """(T, 7) TCP and (T, 7 per object) object poses in the robot base frame (position m,
+        quaternion x y z w), converted for all frames at once."""
         Tb = self._base_inv
         T_off = np.eye(4)
         T_off[AXIS_INDEX[self.arm.config.ee_axis], 3] = self.arm.config.tcp_offset
@@ -133,18 +136,22 @@ class EpisodeRecorder:
         T_ee[:, :3, :3], T_ee[:, :3, 3] = Rotation.from_quat(ee[:, 3:]).as_matrix(), ee[:, :3]
         T_tcp = Tb @ T_ee @ T_off
         tcp = np.concatenate([T_tcp[:, :3, 3], Rotation.from_matrix(T_tcp[:, :3, :3]).as_quat()], axis=1)
-        if self.obj is None:
+        if not self.objs:
             return tcp, np.zeros((len(tcp), 0))
-        obj = self._poses(self.obj_pose)
+        obj = self._poses(self.obj_pose)  # (T * objects, 7), frame-major
         pos = obj[:, :3] @ Tb[:3, :3].T + Tb[:3, 3]
         quat = (Rotation.from_matrix(Tb[:3, :3]) * Rotation.from_quat(obj[:, 3:])).as_quat()
-        return tcp, np.concatenate([pos, quat], axis=1)
+        return tcp, np.concatenate([pos, quat], axis=1).reshape(len(tcp), 7 * len(self.objs))
 
     def final_pose(self) -> list[float]:
-        """The object's world pose now (position m, quaternion x y z w); with no object, the TCP's."""
-        if self.obj is not None:
-            pos, quat = self.world.body_pose_tuple(self.obj)
-            return [*map(float, pos), *map(float, quat)]
+        """The objects' world poses now (position m, quaternion x y z w; 7 values per object, in
+        order); with no object, the TCP's."""
+        if self.objs:
+            out: list[float] = []
+            for bid in self.objs:
+                pos, quat = self.world.body_pose_tuple(bid)
+                out += [*map(float, pos), *map(float, quat)]
+            return out
         from robocfg.geometry.pose import matrix_to_pose
 
         pos, quat = matrix_to_pose(self.arm.tcp_pose())

@@ -5,7 +5,7 @@ The episode's world is rebuilt by the task kind's runner from the task, arm and 
 the dataset (``TaskRunner.replay_scene``: for pick-place the object pose, mass and friction of
 episode k of seed s), then the recorded actions drive the robot through the same command gate as
 when recording, for the same number of physics steps. The outcome matches when success is the
-same and the object (a kind without one: the TCP) ends within ``tolerance`` (m) of its recorded
+same and every object (a kind without one: the TCP) ends within ``tolerance`` (m) of its recorded
 final position.
 """
 
@@ -25,7 +25,8 @@ MATCH_TOLERANCE = 0.001  # m
 
 @dataclass(frozen=True)
 class ReplayResult:
-    """Recorded vs replayed: success, object final position (world, m), their distance (m)."""
+    """Recorded vs replayed: success, final positions (world, m; x y z per object, or the TCP's) and
+    the largest distance between them (m)."""
 
     episode: int
     recorded_success: bool
@@ -65,7 +66,20 @@ def replay_episode(root: Path, k: int, tolerance: float = MATCH_TOLERANCE) -> Re
         finally:
             rec.stop()
         ok, reason = scene.judge()
-        pos = rec.final_pose()[:3]
-    rec_pos = ep.object_final[:3]
-    dist = float(np.linalg.norm(np.subtract(pos, rec_pos)))
-    return ReplayResult(k, ep.success, ok, reason, rec_pos, pos, dist, tolerance)
+        final = rec.final_pose()
+    return ReplayResult(k, ep.success, ok, reason, positions(ep.object_final), positions(final),
+                        farthest(ep.object_final, final), tolerance)
+
+
+def positions(poses: list[float]) -> list[float]:
+    """The positions (x, y, z per object, m) of poses stored as 7 values each."""
+    return [float(v) for v in np.asarray(poses, float).reshape(-1, 7)[:, :3].reshape(-1)]
+
+
+def farthest(recorded: list[float], replayed: list[float]) -> float:
+    """The largest distance (m) between recorded and replayed positions: poses are 7 values each
+    (position, quaternion), one per object (or the TCP's)."""
+    a, b = np.asarray(recorded, float).reshape(-1, 7), np.asarray(replayed, float).reshape(-1, 7)
+    if a.shape != b.shape:
+        raise RobocfgError(f"the dataset stores {len(a)} final pose(s), the replay has {len(b)}")
+    return float(np.linalg.norm(a[:, :3] - b[:, :3], axis=1).max())

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 from robocfg.datasets.episode import CameraLayout, DatasetLayout
 from robocfg.datasets.recorder import EpisodeRecorder, layout_names
+from robocfg.engine.dataset import EpisodeObjects, object_keys
 
 if TYPE_CHECKING:
     from robocfg.sim.camera_rig import Renderer
@@ -70,13 +71,13 @@ class DatasetSink:
     frames: int = field(default=0, init=False)
     _rig: tuple | None = field(default=None, init=False)
 
-    def begin(self, world, arm, obj: int | None, phase_of: Callable[[], str], phases: tuple[str, ...] = (),
+    def begin(self, world, arm, obj: EpisodeObjects, phase_of: Callable[[], str], phases: tuple[str, ...] = (),
               language: str = "") -> EpisodeRecorder:
         from robocfg.sim.camera_rig import CameraRig
 
         cams = self.task.config.cameras
         if self.layout is None:
-            state, env, action = layout_names(arm, has_object=obj is not None)
+            state, env, action = layout_names(arm, tuple(key for key, _ in object_keys(obj)))
             self.layout = DatasetLayout(
                 fps=self.fps, robot=arm.robot.name, task_name=self.task.path.stem, state_names=state,
                 env_state_names=env, action_names=action, phases=tuple(phases) or ("run",),

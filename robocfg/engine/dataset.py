@@ -12,7 +12,7 @@ recorded actions drive it through the same gate.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
@@ -22,6 +22,20 @@ from robocfg.engine.options import option
 if TYPE_CHECKING:
     from robocfg.sim.robot import ArmHandle
     from robocfg.sim.world import World
+
+# What an episode is about: one object's body id, several objects (name → body id, in the task's
+# order: their poses side by side in the environment state), or None (no object).
+EpisodeObjects = int | Mapping[str, int] | None
+
+
+def object_keys(obj: EpisodeObjects) -> tuple[tuple[str, int], ...]:
+    """(feature prefix, body id) per recorded object, in order: ``object`` for one object,
+    ``object.<name>`` for each of several, nothing for none."""
+    if obj is None:
+        return ()
+    if isinstance(obj, int):
+        return (("object", obj),)
+    return tuple((f"object.{name}", int(bid)) for name, bid in obj.items())
 
 
 @dataclass(frozen=True)
@@ -63,11 +77,12 @@ class EpisodeSink(Protocol):
     """Where recorded episodes go (``robocfg.datasets.sink.DatasetSink``; a worker's shard switch).
 
     ``begin``: the episode's world is ready — sample it from now on; ``arm`` acts, ``obj`` is the
-    body id of the object the episode is about (None: no object), ``phase_of()`` names the
+    body id of the object the episode is about, or the objects' (name → id), None: no object
+    (:data:`EpisodeObjects`); ``phase_of()`` names the
     current phase, one of ``phases``; ``language``: the episode's instruction ("" = the sink's).
     ``end``: the episode is over (the tap is stopped) with this outcome."""
 
-    def begin(self, world: World, arm: ArmHandle, obj: int | None, phase_of: Callable[[], str],
+    def begin(self, world: World, arm: ArmHandle, obj: EpisodeObjects, phase_of: Callable[[], str],
               phases: tuple[str, ...], language: str = "") -> EpisodeTap: ...
 
     def end(self, tap: EpisodeTap, index: int, seed: int, success: bool, failed_phase: str | None,
@@ -76,10 +91,10 @@ class EpisodeSink(Protocol):
 
 @dataclass
 class ReplayScene:
-    """Episode k's world as its recording began: ``arm`` to drive, ``obj`` the episode's object
-    (None: none), ``judge()`` → (success, reason) of the outcome once the actions have played."""
+    """Episode k's world as its recording began: ``arm`` to drive, ``obj`` the episode's object(s)
+    (:data:`EpisodeObjects`), ``judge()`` → (success, reason) of the outcome once the actions have played."""
 
     world: World
     arm: ArmHandle
-    obj: int | None
+    obj: EpisodeObjects
     judge: Callable[[], tuple[bool, str]]

@@ -29,7 +29,7 @@ from robocfg.engine.runner import RunOutput, TaskRunner
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
     from robocfg.config.scene import Body
-    from robocfg.engine.dataset import EpisodeTap, ReplayScene
+    from robocfg.engine.dataset import EpisodeObjects, EpisodeTap, ReplayScene
     from robocfg.sim.robot import ArmHandle
     from robocfg.sim.world import World
 
@@ -142,13 +142,14 @@ class EpisodeSession(ABC, Generic[RecordT]):
         """Remove body ``name`` (spawned by this episode) before the next episode's restore."""
         self._spawned.append(name)
 
-    def record_from(self, arm: ArmHandle, obj: int | None, phase_of: Callable[[], str],
+    def record_from(self, arm: ArmHandle, obj: EpisodeObjects, phase_of: Callable[[], str],
                     language: Callable[[], str] | None = None) -> None:
         """With a dataset sink, record this episode from now on (call it once the episode's world
-        is ready, before the first command): ``arm`` acts, ``obj`` is the episode's object body (None:
-        none), ``phase_of()`` names the current phase (one of ``phases``), ``language()``: the
-        episode's instruction (None: the sink's). Without a sink: nothing (``language`` is not
-        called). The engine ends the recording."""
+        is ready, before the first command): ``arm`` acts, ``obj`` is the episode's object body, or
+        several objects' (name → body id, recorded side by side in that order), None: none;
+        ``phase_of()`` names the current phase (one of ``phases``), ``language()``: the episode's
+        instruction (None: the sink's). Without a sink: nothing (``language`` is not called). The
+        engine ends the recording."""
         sink = self.options.sink
         if sink is not None and self._tap is None:
             self._tap = sink.begin(self.world, arm, obj, phase_of, self.phases, language() if language else "")

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -25,6 +26,7 @@ from robocfg.config.commands import Limits, PickPlaceParams, PickPlaceRandomize,
 from robocfg.config.multi_pick import PickObject, PickPlaceManyParams
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
+from robocfg.engine.dataset import DatasetOptions, ReplayScene
 from robocfg.engine.options import FrameRecorder
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
@@ -77,6 +79,11 @@ def spot_points(task, params: PickPlaceManyParams) -> np.ndarray:
     return place_spots(task.config.scene, params.place, radius).points[: len(params.objects)]
 
 
+@dataclass(frozen=True)
+class PickPlaceManyOptions(DatasetOptions):
+    """``run pick-place-many``'s own options: recording a dataset (the CLI builds the sink)."""
+
+
 class ManySession(EpisodeSession[ManyEpisode]):
     """The world, kinematic model, planner, grasp filter and place spots every episode shares.
 
@@ -86,6 +93,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
     moves every result and jammed a shelf release, seed 0)."""
 
     fresh_world_per_episode = True
+    phases = ("setup", "pre_grasp", "approach", "grasp", "lift", "transport", "lower", "release", "retract", "withdraw")
 
     def prepare(self) -> None:
         from robocfg.assets.object_shape import object_shape
@@ -116,14 +124,15 @@ class ManySession(EpisodeSession[ManyEpisode]):
         scene = self.task.config.scene
         self.parts = [b.name for b in [*scene.obstacles, *scene.fixture_parts()]]
 
-    def episode(self, k: int, recorder: FrameRecorder | None) -> ManyEpisode:
+    def _machines(self, k: int, recorder: FrameRecorder | None,
+                  on_step: Callable[[], None] | None) -> dict[str, ObjectMachine]:
+        """Episode ``k``'s objects spawned (each in its region, drawn from ``rng(k)``) and their
+        machines, by name in the task's order."""
         rng = self.rng(k)
         placed = [place_randomly(b, o.region, rng) for b, o in zip(self.bodies, self.params.objects, strict=True)]
         ids = [self.world.add_body(pl.body) for pl in placed]
         for pl in reversed(placed):  # removed last-spawned first (Bullet's arrays shrink from the end)
             self.remove_after_episode(pl.body.name)
-        current: list[ObjectMachine] = []
-        watch = ContactWatch(self.world, self.parts, lambda: current[0].mover.phase if current else "setup")
         clutter = ClutterFilter(self.clutter)
         machines: dict[str, ObjectMachine] = {}
         for i, (pl, bid) in enumerate(zip(placed, ids, strict=True)):
@@ -133,8 +142,24 @@ class ManySession(EpisodeSession[ManyEpisode]):
             tools = dataclasses.replace(self.tools, shape=self.shapes[i])
             machines[body.name] = ObjectMachine(
                 self.world, self.handle, tools, object_params(self.params, body, self.spot_xy[0]), setup, recorder,
-                self.log_for(k), body_id=bid, clutter=clutter, spot=self.spots[0], on_step=watch.on_step,
+                self.log_for(k), body_id=bid, clutter=clutter, spot=self.spots[0], on_step=on_step,
                 place_clearance=self.params.place_clearance)
+        return machines
+
+    def _instruction(self) -> str:
+        from robocfg.checks.clutter import place_fixture
+        from robocfg.config.fixtures import ShelfFixture
+        from robocfg.datasets.language import pick_place_many_instruction
+
+        shelf = isinstance(place_fixture(self.task.config.scene, self.params.place), ShelfFixture)
+        return pick_place_many_instruction(self.params, shelf)
+
+    def episode(self, k: int, recorder: FrameRecorder | None) -> ManyEpisode:
+        current: list[ObjectMachine] = []
+        watch = ContactWatch(self.world, self.parts, lambda: current[0].mover.phase if current else "setup")
+        machines = self._machines(k, recorder, watch.on_step)
+        self.record_from(self.handle, {n: m.obj for n, m in machines.items()},
+                         lambda: current[0].mover.phase if current else "setup", self._instruction)
         first = next(iter(machines.values()))
         first.gripper.open()
         first.mover.settle(0.2)
@@ -164,6 +189,26 @@ class ManySession(EpisodeSession[ManyEpisode]):
             first_contact=watch.first, sim_time=round(self.world.t, 6), steps=self.world.steps, objects=records,
             contacts_by_kind=dict(sorted(watch.by_kind.items())),
             closest_fixture=None if watch.closest is None else round(watch.closest, 6))
+
+    def scene(self, k: int) -> ReplayScene:
+        machines = self._machines(k, None, None)
+
+        def judge() -> tuple[bool, str]:
+            """Every object at rest on its own place spot (the nearest unused one, in the task's
+            order), upright: the run's final check of each object."""
+            free = list(range(len(machines)))
+            for name, m in machines.items():
+                xy = self.world.body_pose(m.obj)[0][:2]
+                j = min(free, key=lambda i: float(np.linalg.norm(self.spot_xy[i] - xy)))
+                free.remove(j)
+                m.assign(self.spot_xy[j], self.spots[j])
+                try:
+                    m._check_placed()
+                except MoveFailed as exc:
+                    return False, f"{name}: {exc.phase}: {exc.reason}"
+            return True, f"{len(machines)} objects placed"
+
+        return ReplayScene(self.world, self.handle, {n: m.obj for n, m in machines.items()}, judge)
 
     def _next(self, machines: dict[str, ObjectMachine], remaining: list[str]) -> str:
         """The next object: the first listed, or (reachability) the one whose collision-free grasp
@@ -214,13 +259,16 @@ class PickPlaceManyRunner(EpisodicRunner):
     kind = "pick_place_many"
     params = PickPlaceManyParams
     report = ManyReport
+    Options = PickPlaceManyOptions
     verb = "cleared"
     summary = "Pick objects in turn into a bin or onto a shelf."
     description = (
         "Each episode randomises every object in its own region, then picks them one at a time (listed order, or "
         "by reachability) with grasps filtered for collisions of the whole arm and gripper with the neighbours and "
         "fixtures, and places them on spots spaced so they do not land on each other. Exit 0 when the share of "
-        "episodes with every object placed reaches --min-success; failures name the object and the phase.")
+        "episodes with every object placed reaches --min-success; failures name the object and the phase. With "
+        "--dataset every episode is recorded as for pick-place, the environment state holding every object's pose "
+        "in the task's order; `robocfg dataset replay` re-simulates an episode from its actions.")
 
     def check(self) -> None:
         super().check()
