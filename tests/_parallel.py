@@ -11,10 +11,11 @@ from _cli import ROOT, run_main
 
 
 def small_camera_task(tmp: Path) -> Path:
-    """The shipped pick-place task with 32x32 cameras."""
+    """The shipped pick-place task with 32x32 cameras, the wrist one with depth."""
     doc = yaml.safe_load((ROOT / "robocfg/data/tasks/pick_place.yaml").read_text())
     for cam in doc["cameras"]:
         cam["width"] = cam["height"] = 32
+    doc["cameras"][1]["depth"] = True
     path = tmp / "pick_place_small_cams.yaml"
     path.write_text(yaml.safe_dump(doc))
     return path

@@ -48,7 +48,7 @@ def _record(tmp: Path, fmt: str, episodes: int, depth: bool = False):
 
 @pytest.fixture(scope="module")
 def lerobot_ds(tmp_path_factory):
-    return _record(tmp_path_factory.mktemp("lr"), "lerobot", 2)
+    return _record(tmp_path_factory.mktemp("lr"), "lerobot", 2, depth=True)
 
 
 def test_lerobot_layout_dtypes_and_index_ranges(lerobot_ds):
@@ -101,6 +101,31 @@ def test_lerobot_layout_dtypes_and_index_ranges(lerobot_ds):
     np.testing.assert_allclose(np.linalg.norm(obj[:, 3:], axis=1), 1.0, atol=1e-5)
     phases = data["phase_index"].to_numpy()
     assert set(info["robocfg"]["phases"][i] for i in np.unique(phases)) >= {"approach", "grasp", "transport", "retract"}
+
+
+def test_lerobot_depth_is_a_float32_height_by_width_feature_in_metres(lerobot_ds):
+    """The wrist camera's depth: an (H, W) float32 feature in the data parquet (nested fixed-size
+    lists: what LeRobotDataset reads as a datasets.Array2D), metres, stats over all pixels."""
+    root, _ = lerobot_ds
+    info = json.loads((root / "meta/info.json").read_text())
+    key = "observation.depth.wrist"
+    assert info["features"][key] == {"dtype": "float32", "shape": [32, 32], "names": ["height", "width"]}
+    assert "observation.depth.scene" not in info["features"] and "metres" in info["robocfg"]["depth"]
+    data = pq.read_table(root / "data/chunk-000/file-000.parquet")
+    t = data.schema.field(key).type
+    assert pa.types.is_fixed_size_list(t) and t.list_size == 32
+    assert pa.types.is_fixed_size_list(t.value_type) and t.value_type.list_size == 32
+    assert t.value_type.value_type == pa.float32()
+    depth = data[key].combine_chunks().flatten().flatten().to_numpy().reshape(-1, 32, 32)
+    assert depth.shape[0] == data.num_rows
+    # metres in front of the wrist: the cube under the gripper while grasping is a few cm away
+    grasping = data["phase_index"].to_numpy() == info["robocfg"]["phases"].index("grasp")
+    assert 0.0 < float(depth[grasping].min()) < 0.2 and float(depth.max()) < 5.0
+    stats = json.loads((root / "meta/stats.json").read_text())[key]
+    assert stats["min"] == [[pytest.approx(float(depth.min()))]] and stats["max"] == [[pytest.approx(float(depth.max()))]]
+    assert stats["mean"][0][0] == pytest.approx(float(depth.astype(np.float64).mean()), rel=1e-9)
+    assert stats["q50"][0][0] == pytest.approx(float(np.median(depth)), abs=1e-3)  # 1 mm bins
+    assert stats["count"] == [data.num_rows]
 
 
 def test_lerobot_videos_have_one_frame_per_row_at_index_over_fps(lerobot_ds):

@@ -1,5 +1,5 @@
 """The dataset sink a ``run`` command records into: every kind whose ``Options`` subclass
-:class:`robocfg.engine.dataset.DatasetOptions` (pick-place, grasp, trajectory) gets the
+:class:`robocfg.engine.dataset.DatasetOptions` (pick-place, pick-place-many, grasp, trajectory) gets the
 ``--dataset*`` options, and :data:`DATASET_HOOK` turns them into a sink before the run and closes
 it (printing its summary) after."""
 
@@ -29,9 +29,6 @@ def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: i
     from robocfg.datasets.recorder import steps_per_frame
 
     steps_per_frame(task.config.sim.timestep, fps)  # the rate must divide the physics rate
-    if fmt == "lerobot" and any(c.depth for c in task.config.cameras):
-        raise RobocfgError("depth images are written to --dataset-format hdf5 only; "
-                           "set 'depth: false' on the task's cameras for lerobot")
     if path.exists() and any(path.iterdir()):
         raise RobocfgError(f"--dataset {path}: the directory exists and is not empty; choose a new one")
     fmt_l: Literal["lerobot", "hdf5"] = "lerobot" if fmt == "lerobot" else "hdf5"

@@ -11,6 +11,12 @@ which a robocfg run reaches only at tens of thousands of episodes)::
     data/chunk-000/file-000.parquet     one row per frame
     videos/<key>/chunk-000/file-000.mp4 every episode's frames of one camera, back to back
 
+Depth (a camera with ``depth: true``) is a float32 feature ``observation.depth.<camera>`` of shape
+(H, W) in the data parquet, metres along the optical axis, stored exactly (a fixed-size list of
+fixed-size lists: what ``LeRobotDataset`` loads as a ``datasets.Array2D``); its statistics are one
+(1, 1) figure each over every pixel (:class:`~robocfg.datasets.stats.DepthStats`). Depth frames are
+held in memory until ``close()`` (64 KiB a frame at 128×128).
+
 Timestamps are ``frame_index / fps``; an episode's video frames start at its
 ``videos/<key>/from_timestamp``. Videos: H.264 (libx264), yuv420p, a keyframe every 2 frames
 (LeRobot's own choice, for exact random access), each episode encoded on its own and the
@@ -28,9 +34,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
-from robocfg.datasets.stats import ImageStats, vector_stats
+from robocfg.datasets.stats import DepthStats, ImageStats, vector_stats
 from robocfg.datasets.video import EncodedVideo, VideoConcat, encode_episode
-from robocfg.errors import RobocfgError
 
 CODEBASE_VERSION = "v3.0"
 DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
@@ -41,6 +46,10 @@ STATE, ENV, ACTION = "observation.state", "observation.environment_state", "acti
 
 def image_key(camera: str) -> str:
     return f"observation.images.{camera}"
+
+
+def depth_key(camera: str) -> str:
+    return f"observation.depth.{camera}"
 
 
 def vector_dims(layout: DatasetLayout) -> dict[str, int]:
@@ -54,9 +63,6 @@ class LeRobotWriter:
     """Add episodes one by one (videos are encoded as they come), then ``close()``."""
 
     def __init__(self, root: Path, layout: DatasetLayout, extra_info: dict):
-        if any(c.depth for c in layout.cameras):
-            raise RobocfgError("depth images are written to --dataset-format hdf5 only; "
-                               "set 'depth: false' on the task's cameras for lerobot")
         self.root, self.layout, self.extra_info = Path(root), layout, extra_info
         self.root.mkdir(parents=True, exist_ok=True)
         self.columns: dict[str, list[np.ndarray]] = {k: [] for k in (STATE, ENV, ACTION, "phase_index", "episode_index",
@@ -68,6 +74,8 @@ class LeRobotWriter:
                                                                          file_index=0), layout.fps)
                        for c in layout.cameras}
         self.image_stats = {c.name: ImageStats() for c in layout.cameras}
+        self.depth: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras if c.depth}  # (T, H, W) m
+        self.depth_stats = {name: DepthStats() for name in self.depth}
 
     def add(self, ep: EpisodeRecord) -> None:
         """Append an episode with its raw images (encoded here, one segment per camera)."""
@@ -77,8 +85,12 @@ class LeRobotWriter:
 
     def add_encoded(self, ep: EpisodeRecord, videos: dict[str, EncodedVideo]) -> None:
         """Append an episode whose camera frames are already encoded (``ep.images`` is not read;
-        their statistics come separately, :meth:`add_image_histograms`)."""
+        their statistics come separately, :meth:`add_image_histograms`); depth from ``ep.depth``."""
         n, k = ep.length, len(self.episodes)
+        for name, frames in self.depth.items():
+            d = np.asarray(ep.depth[name], np.float32)
+            frames.append(d)
+            self.depth_stats[name].add(d)
         task_index = self.tasks.setdefault(ep.language, len(self.tasks))
         for key, arr in ((STATE, ep.state), (ENV, ep.env_state), (ACTION, ep.action), ("phase_index", ep.phase)):
             self.columns[key].append(arr)
@@ -124,6 +136,10 @@ class LeRobotWriter:
             "task_index": pa.array(cols["task_index"].astype(np.int64)),
             "phase_index": pa.array(cols["phase_index"].astype(np.int64)),
         }
+        for c in self.layout.cameras:
+            if c.depth:
+                d = np.concatenate(self.depth[c.name]) if self.depth[c.name] else np.zeros((0, c.height, c.width))
+                arrays[depth_key(c.name)] = _fixed_list(d.reshape(n, c.height, c.width), c.width, c.height)
         _write(pa.table(arrays), self.root / DATA_PATH.format(chunk_index=0, file_index=0))
         _write(pa.Table.from_pylist(self.episodes) if self.episodes else pa.table({"episode_index": pa.array([], pa.int64())}),
                self.root / EPISODES_PATH)
@@ -133,6 +149,7 @@ class LeRobotWriter:
             for key in ("timestamp", "frame_index", "episode_index", "index", "task_index", "phase_index"):
                 stats[key] = vector_stats(np.asarray(arrays[key]))
             stats |= {image_key(c): s.result() for c, s in self.image_stats.items()}
+            stats |= {depth_key(c): s.result() for c, s in self.depth_stats.items()}
         _json(self.root / "meta/stats.json", stats)
         _json(self.root / "meta/info.json", self._info())
         return self.root
@@ -149,6 +166,9 @@ class LeRobotWriter:
                 "info": {"video.height": c.height, "video.width": c.width, "video.codec": "h264",
                          "video.pix_fmt": "yuv420p", "video.is_depth_map": False, "video.fps": lay.fps,
                          "video.channels": 3, "has_audio": False}}
+            if c.depth:
+                features[depth_key(c.name)] = {"dtype": "float32", "shape": [c.height, c.width],
+                                               "names": ["height", "width"]}
         features |= {"timestamp": {"dtype": "float32", "shape": [1], "names": None}, "frame_index": scalar,
                      "episode_index": scalar, "index": scalar, "task_index": scalar, "phase_index": scalar}
         return {
@@ -157,12 +177,20 @@ class LeRobotWriter:
             "chunks_size": 1000, "data_files_size_in_mb": 100, "video_files_size_in_mb": 200, "fps": lay.fps,
             "splits": {"train": f"0:{len(self.episodes)}"}, "data_path": DATA_PATH,
             "video_path": VIDEO_PATH if lay.cameras else None, "features": features,
-            "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, **self.extra_info},
+            "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, **self.extra_info,
+                        **({"depth": DEPTH_NOTE} if any(c.depth for c in lay.cameras) else {})},
         }
 
 
-def _fixed_list(x: np.ndarray, d: int) -> pa.Array:
-    return pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(x, np.float32).reshape(-1)), d)
+DEPTH_NOTE = ("observation.depth.<camera>: float32 (H, W), metres along the camera's optical axis, "
+              "stored exactly in the data parquet; stats over all pixels")
+
+
+def _fixed_list(x: np.ndarray, d: int, rows: int | None = None) -> pa.Array:
+    """Float32 values as fixed-size lists of ``d`` (and, with ``rows``, lists of ``rows`` of those:
+    an (N, rows, d) array, read by ``datasets`` as an Array2D)."""
+    a = pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(x, np.float32).reshape(-1)), d)
+    return a if rows is None else pa.FixedSizeListArray.from_arrays(a, rows)
 
 
 def _write(table: pa.Table, path: Path) -> None:

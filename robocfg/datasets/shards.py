@@ -102,6 +102,7 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
         EPISODES_PATH,
         STATE,
         VIDEO_PATH,
+        depth_key,
         image_key,
         vector_dims,
     )
@@ -116,6 +117,8 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
     if ENV not in vec:  # no object: zero-width environment state
         vec[ENV] = np.zeros((data.num_rows, 0), np.float32)
     phase = data["phase_index"].to_numpy().astype(np.int64)
+    depth = {c.name: np.asarray(data[depth_key(c.name)].combine_chunks().flatten().flatten().to_numpy(), np.float32)
+             .reshape(-1, c.height, c.width) for c in layout.cameras if c.depth}
     lengths = [r["length"] for r in rows]
     segments = {c.name: split_segments(root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
                                                                   file_index=0), layout.fps, lengths)
@@ -126,7 +129,7 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
         ep = EpisodeRecord(index=r["run_episode"], seed=r["seed"], language=r["tasks"][0], success=r["success"],
                            failed_phase=r["failed_phase"], reason=r["reason"], physics_steps=r["physics_steps"],
                            object_final=list(r["object_final"]), state=vec[STATE][a:b], env_state=vec[ENV][a:b],
-                           action=vec[ACTION][a:b], phase=phase[a:b])
+                           action=vec[ACTION][a:b], phase=phase[a:b], depth={k: d[a:b] for k, d in depth.items()})
         out.append((ep, {name: segs[i] for name, segs in segments.items()}))
     return out
 

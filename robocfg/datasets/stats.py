@@ -50,3 +50,46 @@ class ImageStats:
         res: dict[str, list] = {k: np.asarray(val, float).reshape(3, 1, 1).tolist() for k, val in out.items()}
         res["count"] = [self.frames]
         return res
+
+
+class DepthStats:
+    """Running statistics of depth images (m) over every pixel of every frame, as one figure per
+    statistic of shape (1, 1) (it broadcasts against the (H, W) frames): min, max, mean and std
+    exact (float64 sums, episodes added in order), quantiles from a histogram of 1 mm bins (the
+    bin's centre, within min..max). ``count`` is the number of frames."""
+
+    BIN = 0.001  # m
+
+    def __init__(self) -> None:
+        self.frames = 0
+        self.pixels = 0
+        self.sum = self.sumsq = 0.0
+        self.lo, self.hi = np.inf, -np.inf
+        self.hist = np.zeros(0, dtype=np.int64)
+
+    def add(self, depth: np.ndarray) -> None:
+        """``depth``: (T, H, W) float32, m."""
+        x = np.asarray(depth, dtype=np.float64).reshape(-1)
+        if not x.size:
+            return
+        self.frames += int(depth.shape[0])
+        self.pixels += int(x.size)
+        self.sum += float(x.sum())
+        self.sumsq += float(np.square(x).sum())
+        self.lo, self.hi = min(self.lo, float(x.min())), max(self.hi, float(x.max()))
+        counts = np.bincount(np.maximum(np.floor(x / self.BIN), 0).astype(np.int64))
+        if len(counts) > len(self.hist):
+            self.hist = np.pad(self.hist, (0, len(counts) - len(self.hist)))
+        self.hist[: len(counts)] += counts
+
+    def result(self) -> dict[str, list]:
+        n = self.pixels
+        mean = self.sum / n
+        std = float(np.sqrt(max(self.sumsq / n - mean * mean, 0.0)))
+        cdf = np.cumsum(self.hist) / n
+        out = {"min": self.lo, "max": self.hi, "mean": mean, "std": std}
+        out.update({_qkey(q): float(np.clip((int(np.searchsorted(cdf, q)) + 0.5) * self.BIN, self.lo, self.hi))
+                    for q in QUANTILES})
+        res: dict[str, list] = {k: [[float(v)]] for k, v in out.items()}
+        res["count"] = [self.frames]
+        return res
