@@ -57,3 +57,45 @@ def test_pick_place_many_records_every_object_and_replays(tmp_path, capsys, monk
     pq.write_table(data.set_column(data.schema.get_field_index("action"), "action", col), path)
     r = replay_episode(root, 1)
     assert not r.matches and not r.replayed_success and r.replayed_reason.startswith("red: place")
+
+
+def _moving_obstacle_task(tmp) -> str:
+    """A static target and a ball flying onto it (the arm gives way: not reached), 2.2 s."""
+    ball = {"name": "drone", "shape": "sphere", "size": [0.04],
+            "motion": {"type": "waypoints", "waypoints": [[0.45, 0.3, 0.35], [0.45, 0.03, 0.35]],
+                       "waypoint_times": [0.3, 2.0]}}
+    doc = {"schema_version": 1, "task": "follow_target", "robots": [{"robot": "panda"}], "scene": {"ground": True},
+           "sim": {"timestep": 1 / 240},
+           "follow_target": {"motion": {"type": "static", "center": [0.45, 0.0, 0.35]}, "duration": 2.2,
+                             "settle_time": 1.0, "with_obstacle": True, "obstacles": [ball]}}
+    path = tmp / "moving_obstacle.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return str(path)
+
+
+def test_follow_target_records_the_controller_and_replays_with_the_moving_obstacle(tmp_path, capsys, monkeypatch):
+    """The closed-loop controller's joint targets are the actions; replay re-moves the ball at the
+    same control periods: the same outcome, TCP end and closest approach to the ball."""
+    task, root = _moving_obstacle_task(tmp_path), tmp_path / "ft"
+    report = run_json(["run", "follow-target", task, "--dataset", str(root), "--keep", "all", "--dataset-format",
+                       "hdf5"], tmp_path, "ft", capsys, monkeypatch)
+    assert not report["reached"] and report["min_clearance_mm"] > 10.0 and report["contacts"] == 0
+    import h5py
+
+    with h5py.File(root / "data.hdf5", "r") as f:
+        demo = f["data/demo_0"]
+        a = demo.attrs
+        assert not a["success"] and a["failed_phase"] == "track" and "blocked" in a["reason"]
+        assert a["language"] == "reach the target with the tool, avoiding the obstacle"
+        n = a["num_samples"]
+        assert n == a["physics_steps"] // 12 + 1 and demo["actions"].shape == (n, 8)
+        assert set(np.unique(demo["phase"][()])) == {0, 1}  # settle, then track
+        act, q = demo["actions"][()], demo["obs/robot_state"][()][:, :7]
+        assert np.all(act[:, -1] == 1.0) and np.abs(act[-1, :7] - q[-1]).max() < 0.01
+    r = replay_episode(root, 0)
+    assert r.matches and not r.replayed_success and r.distance < 1e-6
+    assert f"min clearance {report['min_clearance_mm']:.2f} mm, 0 contacts" in r.replayed_reason
+    with h5py.File(root / "data.hdf5", "r+") as f:
+        f["data/demo_0/actions"][-10:, 1] += 0.05  # the shoulder's last targets moved by 0.05 rad
+    r = replay_episode(root, 0)
+    assert not r.matches and r.distance > 0.01

@@ -57,3 +57,13 @@ def pick_place_many_instruction(params, shelf: bool) -> str:
     place = params.place
     where = f"onto level {place.level} of {place.fixture}" if shelf else f"into {place.fixture}"
     return f"put {listed} {where}"
+
+
+def follow_target_instruction(motion, obstacles: int) -> str:
+    """E.g. "follow the target around a circle with the tool, avoiding the obstacle"
+    (``motion``: the follow-target Motion; ``obstacles``: how many are in the way)."""
+    what = {"static": "reach the target", "circle": "follow the target around a circle",
+            "figure8": "follow the target along a figure eight",
+            "waypoints": f"follow the target through {len(motion.waypoints)} waypoints"}[motion.type]
+    avoid = "" if not obstacles else ", avoiding the obstacle" + ("s" if obstacles > 1 else "")
+    return f"{what} with the tool{avoid}"

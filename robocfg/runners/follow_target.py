@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -22,6 +24,7 @@ import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import FollowTargetParams, Motion
+from robocfg.engine.dataset import DatasetOptions, EpisodeSink, ReplayScene
 from robocfg.engine.options import RunOptions, option
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import RunOutput, TaskRunner
@@ -38,8 +41,8 @@ __all__ = ["FollowTargetResult", "FollowTargetRunner", "Stats", "run_follow_targ
 
 
 @dataclass(frozen=True)
-class FollowTargetOptions:
-    """``run follow-target``'s own options."""
+class FollowTargetOptions(DatasetOptions):
+    """``run follow-target``'s own options (and the ``--dataset*`` ones: the run is episode 0)."""
 
     with_obstacle: bool | None = field(default=None, metadata=option(
         "--with-obstacle/--without-obstacle",
@@ -57,12 +60,35 @@ class FollowTargetRunner(TaskRunner):
     summary = ("Follow a moving target with the TCP, clear of obstacles. A static / waypoint / circle / figure-8 "
                "target tracked with a QP per control step (placo), keeping the safety margin from obstacles, "
                "table and ground. With --gui, drag the target with the sliders.")
+    description = (
+        "With --dataset the run is recorded as one episode at --dataset-fps: observations, the controller's "
+        "commanded joint positions as actions (sent one frame ahead along its joint velocity, for the frame the "
+        "recording's command gate delays them), success = the target was reached; `robocfg dataset replay` "
+        "re-simulates it from those actions with the same target and obstacle motions.")
 
     def run(self) -> RunOutput:
         o, x = self.options, self.options.extras
         assert isinstance(x, FollowTargetOptions)
         return RunOutput(run_follow_target(self.task, gui=o.gui, with_obstacle=x.with_obstacle, record=o.record,
-                                           plot=x.plot, arm=o.arm, should_stop=o.should_stop, recording=o.recording))
+                                           plot=x.plot, arm=o.arm, should_stop=o.should_stop, recording=o.recording,
+                                           sink=o.sink, seed=o.resolved_seed(self.task.config.sim.seed)))
+
+    @contextmanager
+    def replay_scene(self, k: int) -> Iterator[ReplayScene]:
+        """The run's world as its recording began (obstacles spawned, controller built, arm at home)."""
+        from robocfg.errors import RobocfgError
+        from robocfg.runners import follow_target_dataset
+
+        if k != 0:
+            raise RobocfgError(f"a follow-target run is one episode (0); the dataset says {k}")
+        x = self.options.extras
+        with_obstacle = x.with_obstacle if isinstance(x, FollowTargetOptions) else None
+        params, _note, target = _placed_target(self.task, self.options.arm)
+        use = params.with_obstacle if with_obstacle is None else with_obstacle
+        with follow_target_dataset.replay_scene(
+                self.task, lambda world: FollowLoop(self.task, world, params, target, RunOptions(arm=self.options.arm),
+                                                    use)) as scene:
+            yield scene
 
 
 POSE_SAMPLES = 16  # target poses checked for reach over the run
@@ -94,32 +120,53 @@ def placed_params(task: CheckedTask, arm: str | None, params: FollowTargetParams
     return params.model_copy(update={"motion": motion(params.motion, m), "obstacles": obstacles}), m.note
 
 
+def _placed_target(task: CheckedTask, arm: str | None, params: FollowTargetParams | None = None):
+    """(params moved for ``placement: auto``, the line saying so, the target's motion)."""
+    from robocfg.motion.targets import TargetMotion
+
+    params = params or task.config.follow_target  # type: ignore[union-attr]
+    assert params is not None
+    params, note = placed_params(task, arm, params)
+    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
+                          params.orientation, math.radians(params.follow_angle_deg))
+    return params, note, target
+
+
 def run_follow_target(task: CheckedTask, gui: bool = False, with_obstacle: bool | None = None,
                       record: Path | None = None, plot: Path | None = None,
                       params: FollowTargetParams | None = None, realtime: bool | None = None,
-                      arm: str | None = None, should_stop=None, recording=None) -> FollowTargetResult:
+                      arm: str | None = None, should_stop=None, recording=None, sink: EpisodeSink | None = None,
+                      seed: int = 0) -> FollowTargetResult:
     """Run the follow-target task; returns the result, or raises RunFailed carrying it.
 
     ``with_obstacle`` overrides the task's switch; ``params`` overrides the task's
     ``follow_target`` block (benchmarks use it); ``realtime`` paces the loop to the wall clock
     (default: with ``gui``); ``should_stop`` (SIGINT) ends the loop early, the result marked
-    ``interrupted``; ``recording``: the user's RecordSettings for ``record``.
+    ``interrupted``; ``recording``: the user's RecordSettings for ``record``; ``sink``: a dataset
+    recording the run as episode 0 (stored with ``seed``; success = the target was reached).
     """
-    from robocfg.motion.targets import TargetMotion
+    from robocfg.runners import follow_target_dataset
     from robocfg.sim.world import World
 
-    params = params or task.config.follow_target  # type: ignore[union-attr]
-    assert params is not None
     t_wall = time.perf_counter()
-    params, note = placed_params(task, arm, params)
-    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
-                          params.orientation, math.radians(params.follow_angle_deg))
+    params, note, target = _placed_target(task, arm, params)
     with World(task, gui=gui) as world:
         run = FollowLoop(task, world, params, target, RunOptions(gui=gui, record=record, arm=arm, should_stop=should_stop,
                                                                      recording=recording),
                          params.with_obstacle if with_obstacle is None else with_obstacle)
-        run.loop(gui if realtime is None else realtime)
-        result = run.finish(plot, t_wall)
+        tap = follow_target_dataset.begin(sink, world, run) if sink is not None else None
+        try:
+            run.loop(gui if realtime is None else realtime)
+            result = run.finish(plot, t_wall)
+        except RunFailed as exc:
+            if tap is not None and sink is not None and isinstance(exc.report, FollowTargetResult):
+                follow_target_dataset.end(sink, tap, seed, exc.report)
+            raise
+        finally:
+            if tap is not None:
+                tap.stop()
+        if tap is not None and sink is not None and not result.interrupted:
+            follow_target_dataset.end(sink, tap, seed, result)
     if note:
         result.warnings.insert(0, note)
     if not result.reached:

@@ -142,7 +142,8 @@ class FollowLoop:
                 self.cpu.append(res.cpu_time)
                 if res.blocked:
                     r.blocked_time += self.ctrl_dt
-                self.arm.command(drive_target(res.q, res.dq, self.ctrl_dt, self.n_sub), res.dq)
+                q_cmd = drive_target(res.q, res.dq, self.ctrl_dt, self.n_sub)
+                self.arm.command(q_cmd + self.lead * res.dq if self.lead else q_cmd, res.dq)
                 t_step = time.perf_counter()
                 w.step(self.n_sub)
                 self._measure(dragged)
@@ -155,6 +156,7 @@ class FollowLoop:
             self.failure = exc
 
     failure: RunFailed | None = None
+    lead = 0.0  # s: joint targets sent this far ahead along the QP's velocity (a dataset's gate lag)
 
     def _move_obstacles(self, t: float) -> None:
         for name, (m, T_ob) in self.moving.items():
