@@ -18,11 +18,11 @@ from _parallel import files_of, run_json, small_camera_task
 FPS = "10"  # divides the 240 Hz physics rate; few rendered frames keep the test quick
 
 
-@pytest.mark.parametrize(("fmt", "episodes"), [("lerobot", 4), ("hdf5", 3)])
-def test_two_workers_give_the_report_and_dataset_of_one(fmt, episodes, tmp_path, capsys, monkeypatch):
-    task = str(small_camera_task(tmp_path))
+@pytest.mark.parametrize(("fmt", "episodes", "actions"), [("lerobot", 4, "ee_delta"), ("hdf5", 3, "both")])
+def test_two_workers_give_the_report_and_dataset_of_one(fmt, episodes, actions, tmp_path, capsys, monkeypatch):
+    task = str(small_camera_task(tmp_path))  # depth and EE-delta actions go through the shard merge too
     common = ["run", "pick-place", task, "-n", str(episodes), "--seed", "5", "--dataset-fps", FPS,
-              "--dataset-format", fmt, "--keep", "all"]
+              "--dataset-format", fmt, "--keep", "all", "--dataset-actions", actions]
     one = run_json([*common, "--workers", "1", "--dataset", str(tmp_path / "one")], tmp_path, "one", capsys, monkeypatch)
     two = run_json([*common, "--workers", "2", "--dataset", str(tmp_path / "two")], tmp_path, "two", capsys, monkeypatch)
     assert [e["index"] for e in two["episodes"]] == list(range(episodes))

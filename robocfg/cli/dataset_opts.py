@@ -15,10 +15,11 @@ from robocfg.cli.run_command import CliHook
 
 
 def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: int, arm: str | None,
-                 robot: str | None, language: str, renderer: str = "auto"):
+                 robot: str | None, language: str, renderer: str = "auto", actions: str = "joint"):
     """The sink recording a run into ``path`` (None: no dataset). Bad choices are user errors."""
     if path is None:
         return None
+    from robocfg.datasets.episode import Actions
     from robocfg.datasets.sink import DatasetSink
     from robocfg.errors import RobocfgError
 
@@ -26,6 +27,9 @@ def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: i
         raise typer.BadParameter(f"{fmt!r}: choose lerobot or hdf5", param_hint="--dataset-format")
     if keep not in ("success", "all"):
         raise typer.BadParameter(f"{keep!r}: choose success or all", param_hint="--keep")
+    modes: dict[str, Actions] = {"joint": "joint", "ee_delta": "ee_delta", "both": "both"}
+    if actions not in modes:
+        raise typer.BadParameter(f"{actions!r}: choose one of {', '.join(modes)}", param_hint="--dataset-actions")
     from robocfg.datasets.recorder import steps_per_frame
 
     steps_per_frame(task.config.sim.timestep, fps)  # the rate must divide the physics rate
@@ -40,7 +44,7 @@ def dataset_sink(path: Path | None, fmt: str, fps: int, keep: str, task, seed: i
     if renderer not in renderers:
         raise typer.BadParameter(f"{renderer!r}: choose one of {', '.join(renderers)}", param_hint="--dataset-renderer")
     return DatasetSink(path, fmt_l, task, fps=fps, keep=keep_l, language=language, extra_info=info,
-                       renderer=renderers[renderer])
+                       renderer=renderers[renderer], actions=modes[actions])
 
 
 def _prepare(task: Any, options: Any, robot: str | None) -> Any:
@@ -51,7 +55,7 @@ def _prepare(task: Any, options: Any, robot: str | None) -> Any:
         return options
     seed = options.resolved_seed(task.config.sim.seed)
     sink = dataset_sink(x.dataset, x.dataset_format, x.dataset_fps, x.keep, task, seed, options.arm, robot, "",
-                        x.dataset_renderer)
+                        x.dataset_renderer, x.dataset_actions)
     return dataclasses.replace(options, sink=sink)
 
 

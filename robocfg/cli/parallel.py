@@ -24,7 +24,7 @@ def run_distributed(checked: Any, options: Any, workers: int, executor: str, ray
     target = None
     if sink is not None:
         target = DatasetTarget(Path(sink.root).resolve(), sink.fmt, sink.fps, sink.keep, sink.language,
-                               dict(sink.extra_info), sink.renderer)
+                               dict(sink.extra_info), sink.renderer, sink.actions)
     recipe = EngineRecipe.of(checked, options, target)
     pool = _executor(executor, workers, ray_address)
     t0 = time.perf_counter()

@@ -12,6 +12,11 @@ state the episode starts in). Per frame:
 * ``action``: the arm joint position targets (rad) that the drives reach at frame k + 1 (the
   targets ramp linearly from action k - 1 to action k over the interval), then the gripper
   command (+1 open, -1 close) applied from frame k on — exactly what drove the robot;
+* ``ee_delta`` (``--dataset-actions ee_delta|both``): the commanded TCP pose change of action k,
+  in the robot base frame: T_k = FK(action k's joint targets), position change p_k − p_(k−1) (m),
+  rotation change R_k R_(k−1)^T as a rotation vector (rad, base-frame axes), then the gripper
+  command; frame 0 changes nothing (the gate's first ramp starts at action 0). Summed from frame 0
+  they give the commanded TCP pose relative to action 0's;
 * ``phase``: index into ``DatasetLayout.phases`` of the phase the runner was in;
 * one RGB image (and optional depth, m) per task camera.
 """
@@ -19,8 +24,12 @@ state the episode starts in). Per frame:
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
+
+Actions = Literal["joint", "ee_delta", "both"]
+EE_DELTA_NAMES = ("tcp.dx", "tcp.dy", "tcp.dz", "tcp.drx", "tcp.dry", "tcp.drz", "gripper.command")
 
 
 @dataclass(frozen=True)
@@ -45,6 +54,12 @@ class DatasetLayout:
     action_names: tuple[str, ...]
     phases: tuple[str, ...] = ()  # the kind's phase names (EpisodeSession.phases)
     cameras: tuple[CameraLayout, ...] = ()
+    actions: Actions = "joint"  # which actions are stored (--dataset-actions)
+
+    @property
+    def ee_delta(self) -> bool:
+        """EE-delta actions are stored (as ``action``, or beside the joint ones)."""
+        return self.actions != "joint"
 
 
 @dataclass
@@ -69,6 +84,7 @@ class EpisodeRecord:
     phase: np.ndarray  # (T,) int64
     images: dict[str, np.ndarray] = field(default_factory=dict)  # name -> (T, H, W, 3) uint8
     depth: dict[str, np.ndarray] = field(default_factory=dict)  # name -> (T, H, W) float32, m
+    ee_delta: np.ndarray | None = None  # (T, 7) float32 (EE_DELTA_NAMES) when the layout stores them
 
     @property
     def length(self) -> int:

@@ -5,7 +5,9 @@
 ``states`` (T, S) — robot and object state side by side (robocfg re-simulates from the task and
 seed, not from these), ``rewards`` (1 on the last frame of a successful episode, else 0),
 ``dones`` (1 on the last frame). Attributes: ``data.total`` (frames), ``data.env_args`` (JSON:
-env name, type, the task), per demo ``num_samples`` and robocfg's outcome. ``mask/train`` and
+env name, type, the task), per demo ``num_samples`` and robocfg's outcome. With
+``--dataset-actions both`` the EE-delta actions are ``actions_ee_delta`` beside ``actions``; with
+``ee_delta`` they are ``actions`` and the joint targets ``actions_joint`` (what replay drives with). ``mask/train`` and
 ``mask/valid`` split the demo names 90/10 (every tenth demo is validation).
 """
 
@@ -16,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
+from robocfg.datasets.episode import EE_DELTA_NAMES, DatasetLayout, EpisodeRecord
 
 FILE_NAME = "data.hdf5"
 
@@ -37,7 +39,8 @@ class Hdf5Writer:
             "env_name": layout.task_name, "type": "robocfg", "env_kwargs": {
                 "robot": layout.robot, "fps": layout.fps, "phases": list(layout.phases),
                 "state_names": list(layout.state_names), "object_state_names": list(layout.env_state_names),
-                "action_names": list(layout.action_names), **extra_info}})
+                "action_names": list(layout.action_names), "actions": layout.actions,
+                **({"ee_delta_names": list(EE_DELTA_NAMES)} if layout.ee_delta else {}), **extra_info}})
 
     def add(self, ep: EpisodeRecord) -> None:
         name = f"demo_{len(self.names)}"
@@ -46,7 +49,14 @@ class Hdf5Writer:
         g.attrs.update({"num_samples": n, "success": ep.success, "failed_phase": ep.failed_phase or "",
                         "reason": ep.reason, "seed": ep.seed, "run_episode": ep.index, "language": ep.language,
                         "physics_steps": ep.physics_steps, "object_final": np.asarray(ep.object_final)})
-        g.create_dataset("actions", data=ep.action)
+        mode = self.layout.actions
+        if mode != "joint" and ep.ee_delta is None:
+            raise ValueError("the layout stores EE-delta actions but the episode has none")
+        g.create_dataset("actions", data=ep.ee_delta if mode == "ee_delta" else ep.action)
+        if mode == "ee_delta":
+            g.create_dataset("actions_joint", data=ep.action)
+        elif mode == "both":
+            g.create_dataset("actions_ee_delta", data=ep.ee_delta)
         g.create_dataset("states", data=np.concatenate([ep.state, ep.env_state], axis=1))
         rewards = np.zeros(n, np.float32)
         dones = np.zeros(n, np.int64)

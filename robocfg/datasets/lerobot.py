@@ -42,6 +42,7 @@ DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
 EPISODES_PATH = "meta/episodes/chunk-000/file-000.parquet"
 STATE, ENV, ACTION = "observation.state", "observation.environment_state", "action"
+ACTION_JOINT, ACTION_EE = "action.joint", "action.ee_delta"  # the second action feature (--dataset-actions)
 
 
 def image_key(camera: str) -> str:
@@ -52,11 +53,31 @@ def depth_key(camera: str) -> str:
     return f"observation.depth.{camera}"
 
 
+def vector_names(layout: DatasetLayout) -> dict[str, tuple[str, ...]]:
+    """Feature key → entry names of the float vectors stored, in column order: no environment
+    state when the episodes have no object (e.g. a trajectory run); ``action`` is the joint
+    targets, or with ``--dataset-actions ee_delta`` the EE deltas (the joint targets then in
+    ``action.joint``); ``both`` adds ``action.ee_delta``."""
+    from robocfg.datasets.episode import EE_DELTA_NAMES
+
+    names = {STATE: layout.state_names, ENV: layout.env_state_names}
+    if layout.actions == "ee_delta":
+        names |= {ACTION: EE_DELTA_NAMES, ACTION_JOINT: layout.action_names}
+    else:
+        names |= {ACTION: layout.action_names}
+        if layout.actions == "both":
+            names |= {ACTION_EE: EE_DELTA_NAMES}
+    return {k: v for k, v in names.items() if v or k != ENV}
+
+
 def vector_dims(layout: DatasetLayout) -> dict[str, int]:
-    """Feature key → width of the float vectors stored (no environment state when the episodes
-    have no object, e.g. a trajectory run)."""
-    dims = {STATE: len(layout.state_names), ENV: len(layout.env_state_names), ACTION: len(layout.action_names)}
-    return {k: d for k, d in dims.items() if d or k != ENV}
+    """Feature key → width of the float vectors stored (:func:`vector_names`)."""
+    return {k: len(v) for k, v in vector_names(layout).items()}
+
+
+def joint_action_key(layout_actions: str) -> str:
+    """The feature holding the joint-target actions (what replay drives with)."""
+    return ACTION_JOINT if layout_actions == "ee_delta" else ACTION
 
 
 class LeRobotWriter:
@@ -65,8 +86,9 @@ class LeRobotWriter:
     def __init__(self, root: Path, layout: DatasetLayout, extra_info: dict):
         self.root, self.layout, self.extra_info = Path(root), layout, extra_info
         self.root.mkdir(parents=True, exist_ok=True)
-        self.columns: dict[str, list[np.ndarray]] = {k: [] for k in (STATE, ENV, ACTION, "phase_index", "episode_index",
-                                                                     "frame_index", "task_index")}
+        self.columns: dict[str, list[np.ndarray]] = {k: [] for k in (STATE, ENV, ACTION, ACTION_JOINT, ACTION_EE,
+                                                                     "phase_index", "episode_index", "frame_index",
+                                                                     "task_index")}
         self.episodes: list[dict] = []
         self.tasks: dict[str, int] = {}
         self.frames = 0
@@ -92,7 +114,7 @@ class LeRobotWriter:
             frames.append(d)
             self.depth_stats[name].add(d)
         task_index = self.tasks.setdefault(ep.language, len(self.tasks))
-        for key, arr in ((STATE, ep.state), (ENV, ep.env_state), (ACTION, ep.action), ("phase_index", ep.phase)):
+        for key, arr in ((STATE, ep.state), (ENV, ep.env_state), ("phase_index", ep.phase), *self._actions(ep)):
             self.columns[key].append(arr)
         self.columns["episode_index"].append(np.full(n, k, np.int64))
         self.columns["frame_index"].append(np.arange(n, dtype=np.int64))
@@ -111,6 +133,17 @@ class LeRobotWriter:
                 "run_episode": ep.index, "physics_steps": ep.physics_steps, "object_final": ep.object_final}
         self.episodes.append(row)
         self.frames += n
+
+    def _actions(self, ep: EpisodeRecord) -> list[tuple[str, np.ndarray]]:
+        """(feature key, (T, D) array) of the episode's actions as the layout stores them."""
+        mode = self.layout.actions
+        if mode == "joint":
+            return [(ACTION, ep.action)]
+        if ep.ee_delta is None:
+            raise ValueError("the layout stores EE-delta actions but the episode has none")
+        if mode == "ee_delta":
+            return [(ACTION, ep.ee_delta), (ACTION_JOINT, ep.action)]
+        return [(ACTION, ep.action), (ACTION_EE, ep.ee_delta)]
 
     def add_image_histograms(self, stats: dict[str, ImageStats]) -> None:
         """Add the colour histograms of episodes given by :meth:`add_encoded` (integer counts, so
@@ -157,9 +190,8 @@ class LeRobotWriter:
     def _info(self) -> dict:
         lay = self.layout
         scalar: dict = {"dtype": "int64", "shape": [1], "names": None}
-        names = {STATE: lay.state_names, ENV: lay.env_state_names, ACTION: lay.action_names}
-        features: dict[str, dict] = {key: {"dtype": "float32", "shape": [d], "names": list(names[key])}
-                                     for key, d in vector_dims(lay).items()}
+        features: dict[str, dict] = {key: {"dtype": "float32", "shape": [len(names)], "names": list(names)}
+                                     for key, names in vector_names(lay).items()}
         for c in lay.cameras:
             features[image_key(c.name)] = {
                 "dtype": "video", "shape": [c.height, c.width, 3], "names": ["height", "width", "channels"],
@@ -177,7 +209,7 @@ class LeRobotWriter:
             "chunks_size": 1000, "data_files_size_in_mb": 100, "video_files_size_in_mb": 200, "fps": lay.fps,
             "splits": {"train": f"0:{len(self.episodes)}"}, "data_path": DATA_PATH,
             "video_path": VIDEO_PATH if lay.cameras else None, "features": features,
-            "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, **self.extra_info,
+            "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, "actions": lay.actions, **self.extra_info,
                         **({"depth": DEPTH_NOTE} if any(c.depth for c in lay.cameras) else {})},
         }
 

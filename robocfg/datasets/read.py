@@ -15,7 +15,7 @@ from robocfg.errors import RobocfgError
 @dataclass(frozen=True)
 class EpisodeMeta:
     """A stored episode: its run's episode index and seed, outcome, physics steps, the object's
-    final world pose (position m, quaternion x y z w) and the recorded actions (T, A)."""
+    final world pose (position m, quaternion x y z w) and the recorded joint-target actions (T, A)."""
 
     dataset_index: int
     run_episode: int
@@ -97,10 +97,13 @@ def read_episode(root: Path, k: int) -> EpisodeMeta:
         import pyarrow.compute as pc
         import pyarrow.parquet as pq
 
+        from robocfg.datasets.lerobot import joint_action_key
+
         e = pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").to_pylist()[k]
-        data = pq.read_table(root / "data/chunk-000/file-000.parquet", columns=["episode_index", "frame_index", "action"])
+        key = joint_action_key(read_info(root).run.get("actions", "joint"))
+        data = pq.read_table(root / "data/chunk-000/file-000.parquet", columns=["episode_index", "frame_index", key])
         rows = data.filter(pc.equal(data["episode_index"], k))
-        actions = np.asarray(rows["action"].to_pylist(), np.float64)[np.argsort(rows["frame_index"].to_numpy())]
+        actions = np.asarray(rows[key].to_pylist(), np.float64)[np.argsort(rows["frame_index"].to_numpy())]
         return EpisodeMeta(k, e["run_episode"], e["seed"], bool(e["success"]), e["failed_phase"], e["reason"],
                            e["physics_steps"], list(e["object_final"]), actions)
     import h5py
@@ -108,6 +111,7 @@ def read_episode(root: Path, k: int) -> EpisodeMeta:
     with h5py.File(_h5_path(root), "r") as f:
         g = f["data"][f"demo_{k}"]
         a = g.attrs
+        joint = "actions_joint" if "actions_joint" in g else "actions"
         return EpisodeMeta(k, int(a["run_episode"]), int(a["seed"]), bool(a["success"]), str(a["failed_phase"]) or None,
                            str(a["reason"]), int(a["physics_steps"]), [float(v) for v in a["object_final"]],
-                           np.asarray(g["actions"][()], np.float64))
+                           np.asarray(g[joint][()], np.float64))

@@ -48,10 +48,12 @@ class EpisodeRecorder:
     objects' (name → id), None: no object); ``language``: the episode's instruction ("": the sink's)."""
 
     def __init__(self, world, arm, obj: EpisodeObjects, layout: DatasetLayout, rig, phase_of: Callable[[], str],
-                 replay_actions: np.ndarray | None = None, language: str = ""):
+                 replay_actions: np.ndarray | None = None, language: str = "",
+                 tcp_fk: Callable[[np.ndarray], np.ndarray] | None = None):
         self.world, self.arm, self.layout, self.rig = world, arm, layout, rig
         self.objs = [bid for _, bid in object_keys(obj)]  # body ids, in the env_state's order
         self.phase_of, self.language = phase_of, language
+        self.tcp_fk = tcp_fk  # arm joint values -> base_T_tcp (4x4), for EE-delta actions
         self.n = steps_per_frame(world.dt, layout.fps)
         self.gate = CommandGate(world, arm, self.n)
         self.replay_actions = replay_actions
@@ -161,6 +163,8 @@ class EpisodeRecorder:
                reason: str) -> EpisodeRecord:
         """The episode's record (the recorder is stopped)."""
         self.stop()
+        action = np.asarray(self.actions, np.float32)
+        ee_delta = ee_deltas(action, self.tcp_fk) if self.layout.ee_delta and self.tcp_fk is not None else None
         tcp, env = self._in_base()
         n = len(tcp)
         joints = np.concatenate([np.asarray(self.q, float).reshape(n, -1), np.asarray(self.qd, float).reshape(n, -1)],
@@ -170,7 +174,18 @@ class EpisodeRecorder:
             index=index, seed=seed, language=self.language or language, success=success, failed_phase=failed_phase,
             reason=reason, physics_steps=self.world.steps, object_final=self.final_pose(),
             state=state.astype(np.float32), env_state=env.astype(np.float32),
-            action=np.asarray(self.actions, np.float32), phase=np.asarray(self.phases, np.int64),
+            action=action, phase=np.asarray(self.phases, np.int64), ee_delta=ee_delta,
             images={k: np.asarray(v, np.uint8) for k, v in self.images.items()},
             depth={k: np.asarray(v, np.float32) for k, v in self.depth.items()},
         )
+
+
+def ee_deltas(action: np.ndarray, tcp_fk: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """(T, 7) float32 EE-delta actions of joint actions (T, arm joints + 1): the TCP pose change
+    from action k − 1 to action k in the robot base frame (position m, rotation vector rad), then
+    the gripper command; row 0 is zero motion (see :mod:`robocfg.datasets.episode`)."""
+    T = np.array([tcp_fk(a[:-1].astype(np.float64)) for a in action]).reshape(-1, 4, 4)
+    prev = np.concatenate([T[:1], T[:-1]])
+    dp = T[:, :3, 3] - prev[:, :3, 3]
+    rv = Rotation.from_matrix(T[:, :3, :3] @ np.transpose(prev[:, :3, :3], (0, 2, 1))).as_rotvec()
+    return np.concatenate([dp, rv, action[:, -1:]], axis=1).astype(np.float32)

@@ -97,6 +97,8 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
 
     from robocfg.datasets.lerobot import (
         ACTION,
+        ACTION_EE,
+        ACTION_JOINT,
         DATA_PATH,
         ENV,
         EPISODES_PATH,
@@ -126,10 +128,12 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
     out = []
     for i, r in enumerate(rows):
         a, b = r["dataset_from_index"], r["dataset_to_index"]
+        joint, ee = (ACTION_JOINT, ACTION) if layout.actions == "ee_delta" else (ACTION, ACTION_EE)
         ep = EpisodeRecord(index=r["run_episode"], seed=r["seed"], language=r["tasks"][0], success=r["success"],
                            failed_phase=r["failed_phase"], reason=r["reason"], physics_steps=r["physics_steps"],
                            object_final=list(r["object_final"]), state=vec[STATE][a:b], env_state=vec[ENV][a:b],
-                           action=vec[ACTION][a:b], phase=phase[a:b], depth={k: d[a:b] for k, d in depth.items()})
+                           action=vec[joint][a:b], phase=phase[a:b], depth={k: d[a:b] for k, d in depth.items()},
+                           ee_delta=vec[ee][a:b] if layout.ee_delta else None)
         out.append((ep, {name: segs[i] for name, segs in segments.items()}))
     return out
 
@@ -145,11 +149,14 @@ def _read_hdf5(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeRecord,
             g = f["data"][name]
             a = g.attrs
             obs = g["obs"]
+            mode = layout.actions
+            joint = g["actions_joint" if mode == "ee_delta" else "actions"][()]
+            ee = g["actions" if mode == "ee_delta" else "actions_ee_delta"][()] if layout.ee_delta else None
             ep = EpisodeRecord(
                 index=int(a["run_episode"]), seed=int(a["seed"]), language=str(a["language"]),
                 success=bool(a["success"]), failed_phase=str(a["failed_phase"]) or None, reason=str(a["reason"]),
                 physics_steps=int(a["physics_steps"]), object_final=[float(v) for v in a["object_final"]],
-                state=obs["robot_state"][()], env_state=obs["object_state"][()], action=g["actions"][()],
+                state=obs["robot_state"][()], env_state=obs["object_state"][()], action=joint, ee_delta=ee,
                 phase=g["phase"][()],
                 images={c.name: obs[f"{c.name}_image"][()] for c in layout.cameras},
                 depth={c.name: obs[f"{c.name}_depth"][()] for c in layout.cameras if c.depth})

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-from robocfg.datasets.episode import CameraLayout, DatasetLayout
+from robocfg.datasets.episode import Actions, CameraLayout, DatasetLayout
 from robocfg.datasets.recorder import EpisodeRecorder, layout_names
 from robocfg.engine.dataset import EpisodeObjects, object_keys
 
@@ -64,12 +64,14 @@ class DatasetSink:
     language: str = ""
     extra_info: dict = field(default_factory=dict)
     renderer: Renderer = "auto"
+    actions: Actions = "joint"  # --dataset-actions
     writer: Any = field(default=None, init=False)
     layout: DatasetLayout | None = field(default=None, init=False)
     run: int = field(default=0, init=False)
     kept: int = field(default=0, init=False)
     frames: int = field(default=0, init=False)
     _rig: tuple | None = field(default=None, init=False)
+    _fk: dict[str, Callable] = field(default_factory=dict, init=False)  # arm name -> base_T_tcp(q)
 
     def begin(self, world, arm, obj: EpisodeObjects, phase_of: Callable[[], str], phases: tuple[str, ...] = (),
               language: str = "") -> EpisodeRecorder:
@@ -81,15 +83,26 @@ class DatasetSink:
             self.layout = DatasetLayout(
                 fps=self.fps, robot=arm.robot.name, task_name=self.task.path.stem, state_names=state,
                 env_state_names=env, action_names=action, phases=tuple(phases) or ("run",),
-                cameras=tuple(CameraLayout(c.name, c.height, c.width, c.depth) for c in cams))
+                cameras=tuple(CameraLayout(c.name, c.height, c.width, c.depth) for c in cams), actions=self.actions)
             self.writer = make_writer(self.fmt, Path(self.root), self.layout, self.extra_info)
         if self._rig is None or self._rig[0] is not world:
             if self._rig is not None:
                 self._rig[1].close()
             self._rig = (world, CameraRig(world, arm, cams, self.renderer))
-        rec = EpisodeRecorder(world, arm, obj, self.layout, self._rig[1], phase_of, language=language)
+        rec = EpisodeRecorder(world, arm, obj, self.layout, self._rig[1], phase_of, language=language,
+                              tcp_fk=self._tcp_fk(arm) if self.layout.ee_delta else None)
         rec.start()
         return rec
+
+    def _tcp_fk(self, arm) -> Callable:
+        """base_T_tcp (4x4) of ``arm``'s joint values: a kinematic model with the base at the
+        origin, built once per arm (other joints locked as the controllers lock them)."""
+        if arm.config.name not in self._fk:
+            from robocfg.kinematics.model import KinematicModel
+
+            model = KinematicModel.from_robot(arm.robot.checked, arm.config.name)
+            self._fk[arm.config.name] = model.fk
+        return self._fk[arm.config.name]
 
     def end(self, rec: EpisodeRecorder, index: int, seed: int, success: bool, failed_phase: str | None,
             reason: str) -> None:

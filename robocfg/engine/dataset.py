@@ -50,6 +50,11 @@ class DatasetOptions:
         help="lerobot (LeRobot v3.0: parquet + MP4) or hdf5 (robomimic layout)."))
     dataset_fps: int = field(default=20, metadata=option(
         "--dataset-fps", minimum=1, help="Frames per second of simulated time (must divide the physics rate)."))
+    dataset_actions: str = field(default="joint", metadata=option(
+        "--dataset-actions", choices=("joint", "ee_delta", "both"),
+        help="joint: action = joint position targets + gripper; ee_delta: action = the commanded TCP pose change per "
+             "frame (base frame: dx dy dz m, rotation vector rad) + gripper, the joint targets kept as action.joint; "
+             "both: joint actions and action.ee_delta. Replay always uses the joint targets."))
     keep: str = field(default="success", metadata=option(
         "--keep", choices=("success", "all"), help="success: write successful episodes only; all: failures too, labelled."))
     dataset_renderer: str = field(default="auto", metadata=option(

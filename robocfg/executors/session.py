@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
+    from robocfg.datasets.episode import Actions
     from robocfg.datasets.shards import Shard
     from robocfg.datasets.sink import DatasetSink, Format, Keep
     from robocfg.sim.camera_rig import Renderer
@@ -93,6 +94,7 @@ class DatasetTarget:
     language: str
     extra_info: dict = field(default_factory=dict)
     renderer: Renderer = "auto"  # camera images (robocfg.sim.camera_rig)
+    actions: Actions = "joint"  # which actions are stored (--dataset-actions)
 
     def shard_root(self, batch: int) -> Path:
         return Path(self.root) / ".shards" / f"batch-{batch:05d}"
@@ -101,7 +103,7 @@ class DatasetTarget:
         from robocfg.datasets.sink import DatasetSink
 
         return DatasetSink(root, self.fmt, task, fps=self.fps, keep=self.keep, language=self.language,
-                           extra_info=dict(self.extra_info), renderer=self.renderer)
+                           extra_info=dict(self.extra_info), renderer=self.renderer, actions=self.actions)
 
 
 @dataclass(frozen=True)
