@@ -9,7 +9,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import yaml
-from _cli import ROOT
+from _cli import ROOT, run_main
 from _parallel import files_of, run_json
 
 from robocfg.datasets.replay import replay_episode
@@ -99,3 +99,8 @@ def test_follow_target_records_the_controller_and_replays_with_the_moving_obstac
         f["data/demo_0/actions"][-10:, 1] += 0.05  # the shoulder's last targets moved by 0.05 rad
     r = replay_episode(root, 0)
     assert not r.matches and r.distance > 0.01
+
+
+def test_follow_target_dataset_with_gui_is_refused(tmp_path, capsys, monkeypatch):
+    code, _, err = run_main(["run", "follow-target", "--gui", "--dataset", str(tmp_path / "x")], capsys, monkeypatch)
+    assert code == 2 and "--dataset with --gui" in err and not (tmp_path / "x").exists()

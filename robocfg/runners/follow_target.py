@@ -66,6 +66,15 @@ class FollowTargetRunner(TaskRunner):
         "recording's command gate delays them), success = the target was reached; `robocfg dataset replay` "
         "re-simulates it from those actions with the same target and obstacle motions.")
 
+    def check(self) -> None:
+        super().check()
+        from robocfg.errors import ConfigError, Problem
+
+        x = self.options.extras
+        if isinstance(x, FollowTargetOptions) and x.dataset is not None and self.options.gui:
+            raise ConfigError([Problem("--dataset", None, None, "", "--dataset with --gui: a target dragged with "
+                                       "the sliders is not recorded, so the run could not be replayed; drop --gui")])
+
     def run(self) -> RunOutput:
         o, x = self.options, self.options.extras
         assert isinstance(x, FollowTargetOptions)
