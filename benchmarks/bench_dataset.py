@@ -1,5 +1,6 @@
 """Dataset recording cost: successful pick-place demos per core-minute without a dataset, with a
-state-only dataset and with two 128x128 cameras (20 Hz); camera frames/s per renderer option;
+state-only dataset (joint actions; and with EE-delta actions too, ``--dataset-actions both``) and
+with two 128x128 cameras (20 Hz; and with the wrist camera's depth); camera frames/s per renderer option;
 size on disk and pyarrow load time of a larger state-only dataset.
 
     python benchmarks/bench_dataset.py --episodes 20 --camera-episodes 4 --size-episodes 1000 [--json out.json]
@@ -31,16 +32,19 @@ from pathlib import Path
 WRITER_MODULES = {"lerobot": ("pyarrow.parquet", "robocfg.datasets.lerobot"), "hdf5": ("robocfg.datasets.hdf5", "h5py")}
 
 
-def _task(name: str, cameras: bool, size: int = 128):
+def _task(name: str, cameras: bool, size: int = 128, depth: bool = False):
+    """The shipped task, its cameras at ``size`` (none without ``cameras``; ``depth``: the wrist
+    camera records depth too)."""
     from robocfg.checks import load_task
     from robocfg.config import catalog
 
     t = load_task(catalog.find("tasks", name))
-    cams = [c.model_copy(update={"width": size, "height": size}) for c in t.config.cameras] if cameras else []
+    cams = [c.model_copy(update={"width": size, "height": size, "depth": depth and c.name == "wrist"})
+            for c in t.config.cameras] if cameras else []
     return dataclasses.replace(t, config=t.config.model_copy(update={"cameras": cams}))
 
 
-def _run(task, episodes: int, seed: int, fmt: str | None, out: Path) -> dict:
+def _run(task, episodes: int, seed: int, fmt: str | None, out: Path, actions: str = "joint") -> dict:
     from robocfg.datasets.language import pick_place_instruction
     from robocfg.datasets.sink import DatasetSink
     from robocfg.runners.pick_place import run_pick_place
@@ -49,7 +53,8 @@ def _run(task, episodes: int, seed: int, fmt: str | None, out: Path) -> dict:
     if fmt is not None:
         shutil.rmtree(out, ignore_errors=True)
         sink = DatasetSink(out, fmt, task, language=pick_place_instruction(task.config.pick_place),
-                           extra_info={"task_path": str(task.path), "seed": seed, "arm": None, "robot_override": None})
+                           extra_info={"task_path": str(task.path), "seed": seed, "arm": None, "robot_override": None},
+                           actions=actions)  # type: ignore[arg-type]
     t0, c0 = time.perf_counter(), time.process_time()
     report, _ = run_pick_place(task, episodes, seed, sink=sink)
     if sink is not None:
@@ -116,12 +121,17 @@ def main() -> None:
     res["rows"]["no dataset"] = _run(state, args.episodes, args.seed, None, tmp / "none")
     res["rows"]["state-only lerobot"] = _run(state, args.episodes, args.seed, "lerobot", tmp / "state_lr")
     res["rows"]["state-only hdf5"] = _run(state, args.episodes, args.seed, "hdf5", tmp / "state_h5")
+    res["rows"]["state-only lerobot, --dataset-actions both"] = _run(state, args.episodes, args.seed, "lerobot",
+                                                                     tmp / "state_ee", actions="both")
     res["rows"]["2 cameras 128x128 lerobot"] = _run(cams, args.camera_episodes, args.seed, "lerobot", tmp / "cams")
+    res["rows"]["2 cameras 128x128 + wrist depth lerobot"] = _run(_task("pick_place", True, depth=True),
+                                                                  args.camera_episodes, args.seed, "lerobot",
+                                                                  tmp / "cams_depth")
     base = res["rows"]["no dataset"]["cpu_s"] / args.episodes  # CPU seconds per episode
-    for k in ("state-only lerobot", "state-only hdf5"):
+    for k in ("state-only lerobot", "state-only hdf5", "state-only lerobot, --dataset-actions both"):
         res["rows"][k]["cost_vs_none"] = round(res["rows"][k]["cpu_s"] / args.episodes / base, 3)
-    res["rows"]["2 cameras 128x128 lerobot"]["cost_vs_none"] = round(
-        res["rows"]["2 cameras 128x128 lerobot"]["cpu_s"] / args.camera_episodes / base, 3)
+    for k in ("2 cameras 128x128 lerobot", "2 cameras 128x128 + wrist depth lerobot"):
+        res["rows"][k]["cost_vs_none"] = round(res["rows"][k]["cpu_s"] / args.camera_episodes / base, 3)
     res["render_frames_per_s"] = {}
     for r in args.renderers.split(","):
         for size in (64, 128, 256):
