@@ -11,6 +11,9 @@ Continuous joints are modelled as revolute joints with limits [-π, π]; they an
 range spans 2π or more are *wrapped* (not clamped) by the IK solvers.
 
 pinocchio is imported here: import this module lazily from the CLI.
+
+Length (≈ 310 lines): one concept, the model's construction and its queries (FK, sampled FK
+positions, Jacobians, IK dispatch); the IK solvers themselves live in :mod:`robocfg.kinematics.ik`.
 """
 
 from __future__ import annotations

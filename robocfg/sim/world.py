@@ -11,6 +11,11 @@ One ``World`` = one PyBullet client (``DIRECT`` unless ``gui``); every call pass
 Frames: world z up, m. ``step()`` advances physics, updates the grippers, and raises
 ``PhysicsDiverged`` on NaN or velocities beyond ``max_joint_velocity`` / ``max_body_speed``
 (checked every ``check_interval`` s of simulated time, so a divergence is reported within 20 ms).
+``play(arm, q, qd)`` plays a sampled trajectory with one motor call per physics step
+(:mod:`robocfg.sim.playback`).
+
+Length (≈ 315 lines): one concept, the world's build and its step; the physics queries already
+live in :mod:`robocfg.sim.queries` and the trajectory playback in :mod:`robocfg.sim.playback`.
 """
 
 from __future__ import annotations
