@@ -99,3 +99,29 @@ def test_a_suction_tool_is_not_turned_about_its_axis():
     assert free.reached and free.orientation_error_deg.max < 0.1 and free.position_error_mm.max < 1.0
     assert not tracked.reached and tracked.orientation_error_deg.max > 10.0  # still turning after 1 s
     assert free.samples[0][2] < 1.0 < 170.0 < tracked.samples[0][2]  # the same start, measured both ways
+
+
+def test_a_scaled_motion_keeps_its_times_unless_the_joints_cannot_keep_up():
+    """placement auto on the KR 210: the circle ×3.2 keeps its period (same angular speed; the TCP
+    speed cap scales with it) because its joints need ≈ 19 % of their velocity limits for it; with
+    the limits cut to a tenth (velocity_scale 0.1) they would need ≈ 190 %, and the times are
+    stretched until they need 80 %."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.runners.follow_target import JOINT_SPEED_SHARE, placed_params
+
+    task = load_task(catalog.find("tasks", "follow_target"), robot_override="kuka_kr210")
+    given = task.config.follow_target
+    kept, note = placed_params(task, None, given)
+    k = kept.motion.radius / given.motion.radius
+    assert kept.motion.period == given.motion.period and kept.duration == given.duration
+    assert kept.max_speed == pytest.approx(given.max_speed * k)
+    assert "times kept (the same angular speed)" in note
+    share = float(note.split("the joints at most ")[1].split("%")[0]) / 100
+    assert 0.05 < share < JOINT_SPEED_SHARE
+
+    slow = given.model_copy(update={"velocity_scale": 0.1})
+    paced, note = placed_params(task, None, slow)
+    s = paced.motion.period / given.motion.period
+    assert s == pytest.approx(share * 10 / JOINT_SPEED_SHARE, rel=0.05)
+    assert paced.duration == pytest.approx(given.duration * s) and f"times x{s:.2f}" in note

@@ -101,6 +101,7 @@ class FollowTargetRunner(TaskRunner):
 
 
 POSE_SAMPLES = 16  # target poses checked for reach over the run
+JOINT_SPEED_SHARE = 0.8  # of the joint velocity limits a mapped motion may need (the rest: the servo's corrections)
 
 
 def placed_params(task: CheckedTask, arm: str | None, params: FollowTargetParams) -> tuple[FollowTargetParams, str]:
@@ -126,7 +127,35 @@ def placed_params(task: CheckedTask, arm: str | None, params: FollowTargetParams
     obstacles = [o.model_copy(update={"position": m.point(o.position), "size": [m.length(v) for v in o.size],
                                       "motion": None if o.motion is None else motion(o.motion, m)})
                  for o in params.obstacles]
-    return params.model_copy(update={"motion": motion(params.motion, m), "obstacles": obstacles}), m.note
+    placed = params.model_copy(update={"motion": motion(params.motion, m), "obstacles": obstacles,
+                                       "max_speed": m.length(params.max_speed)})
+    return _paced(task, arm, placed, m.scale, m.note)
+
+
+def _paced(task: CheckedTask, arm: str | None, params: FollowTargetParams, k: float, note: str) -> tuple[FollowTargetParams, str]:
+    """Times for a motion scaled ×k: kept (the same angular speed, TCP speeds and the speed cap ×k)
+    while the arm's joints need at most ``JOINT_SPEED_SHARE`` of their velocity limits for it
+    (``robocfg.motion.target_speed``); else stretched until they do. The note says which."""
+    from robocfg.motion.target_speed import arm_joint_speed
+    from robocfg.motion.targets import TargetMotion
+
+    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
+                          params.orientation, math.radians(params.follow_angle_deg))
+    js = arm_joint_speed(task, arm, target, params.duration, params.velocity_scale)
+    missed = f", {js.unreached} of {js.samples} sampled poses out of IK reach" if js.unreached else ""
+    if js.share <= JOINT_SPEED_SHARE:
+        return params, (f"{note}; times kept (the same angular speed): the target up to {js.tcp_speed:.2f} m/s, the joints "
+                        f"at most {js.share:.0%} of their velocity limits{missed}")
+    s = js.share / JOINT_SPEED_SHARE
+
+    def slower(mo: Motion) -> Motion:
+        return mo.model_copy(update={"period": mo.period * s, "waypoint_times": [t * s for t in mo.waypoint_times]})
+
+    obstacles = [o if o.motion is None else o.model_copy(update={"motion": slower(o.motion)}) for o in params.obstacles]
+    paced = params.model_copy(update={"motion": slower(params.motion), "obstacles": obstacles,
+                                      "duration": params.duration * s})
+    return paced, (f"{note}; times x{s:.2f} (period, waypoint times, duration): at the same angular speed the joints "
+                   f"would need {js.share:.0%} of their velocity limits, now {JOINT_SPEED_SHARE:.0%}{missed}")
 
 
 def _placed_target(task: CheckedTask, arm: str | None, params: FollowTargetParams | None = None):

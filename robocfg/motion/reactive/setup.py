@@ -23,6 +23,14 @@ if TYPE_CHECKING:
 DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
 
 
+def velocity_limits(robot: CheckedRobot, arm: str | None = None) -> np.ndarray:
+    """Joint velocity limits (rad/s, arm-joint order): the robot YAML's ``drives.velocity_limits``,
+    else the URDF's, else ``DEFAULT_VELOCITY``."""
+    names = robot.arm_joints(robot.config.arm(arm))
+    limits = robot.config.drives.velocity_limits
+    return np.array([limits.get(n) or robot.urdf.joints[n].velocity or DEFAULT_VELOCITY for n in names])
+
+
 def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: str | None = None,
              acceleration: float = 10.0, velocity_scale: float = 1.0,
              other_joints: dict[str, float] | None = None) -> ArmSpec:
@@ -37,7 +45,7 @@ def arm_spec(robot: CheckedRobot, urdf_path: Path, base_pose: np.ndarray, arm: s
     arm_cfg = cfg.arm(arm)
     names = robot.arm_joints(arm_cfg)
     urdf = robot.urdf
-    vel = np.array([cfg.drives.velocity_limits.get(n) or urdf.joints[n].velocity or DEFAULT_VELOCITY for n in names])
+    vel = velocity_limits(robot, arm_cfg.name)
     acc = np.array([cfg.drives.acceleration_limits.get(n, acceleration) for n in names])
     T_ee_tcp = np.eye(4)
     T_ee_tcp[AXIS_INDEX[arm_cfg.ee_axis], 3] = arm_cfg.tcp_offset
