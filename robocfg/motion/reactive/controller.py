@@ -1,7 +1,8 @@
 """Reactive Cartesian controller: one placo QP per control step.
 
 Each step solves for a joint step ``Δq`` (rad) that moves ``ee_link`` towards a servo pose (the
-target's feed-forward velocity plus ``gain`` × the error, speed-capped; a soft frame task),
+target's feed-forward velocity plus ``gain`` × the error, braked so the approach can stop with
+``max_*_acceleration``, speed-capped; a soft frame task),
 keeps the arm near its posture (a tiny-weight joints task) with damped least squares (a
 regularisation task), respects joint position/velocity/acceleration limits (a hard joint-space box
 with braking distance, see :mod:`.limits`), and keeps every robot–environment (and non-adjacent
@@ -20,6 +21,7 @@ where it points is tracked. Frames: world, 4×4 transforms, metres.
 from __future__ import annotations
 
 import contextlib
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -77,6 +79,8 @@ class ReactiveSettings:
     gain: float = 20.0  # 1/s: Cartesian servo gain (the QP is asked to close gain·dt of the error)
     max_linear_speed: float = 1.0  # m/s: cap on the commanded TCP speed
     max_angular_speed: float = 2.0  # rad/s
+    max_linear_acceleration: float = 2.0  # m/s²: the servo's approach brakes at most this hard
+    max_angular_acceleration: float = 5.0  # rad/s²
     free_roll: bool = False  # an axis-symmetric tool (suction cup): the roll about ArmSpec.tool_axis is not tracked
     escape: EscapeSettings = field(default_factory=EscapeSettings)
 
@@ -132,6 +136,18 @@ def _quiet_stdout():
         os.dup2(saved, 1)
         os.close(saved)
         os.close(devnull)
+
+
+def _braked(error: np.ndarray, k: float, accel: float, dt: float) -> np.ndarray:
+    """The feedback step (m or rad per control period) for ``error``: ``k`` × the error, shortened so
+    the speed it asks for can still brake to rest at the target with ``accel`` (m/s² or rad/s²),
+    at most ``sqrt(2·accel·|error|)``. Near the target the proportional servo rules; from further
+    the approach decelerates as hard as ``accel`` allows instead of stopping within a few periods
+    (which the joints' acceleration limits cannot follow, so the QP traded position for it)."""
+    e = float(np.linalg.norm(error))
+    if e <= 0.0:
+        return np.zeros_like(error)
+    return error * (min(k * e, math.sqrt(2.0 * accel * e) * dt) / e)
 
 
 class ReactiveController:
@@ -236,11 +252,12 @@ class ReactiveController:
 
         dt, k = self.s.dt, min(self.s.gain * self.s.dt, 1.0)
         v = np.zeros(6) if velocity is None else np.asarray(velocity, float)
-        dp = v[:3] * dt + k * (target[:3, 3] - T_tcp[:3, 3])
+        dp = v[:3] * dt + _braked(target[:3, 3] - T_tcp[:3, 3], k, self.s.max_linear_acceleration, dt)
         n = float(np.linalg.norm(dp))
         if n > self.s.max_linear_speed * dt:
             dp *= self.s.max_linear_speed * dt / n
-        dw = v[3:] * dt + k * (T_tcp[:3, :3] @ pin.log3(T_tcp[:3, :3].T @ target[:3, :3]))
+        dw = v[3:] * dt + _braked(T_tcp[:3, :3] @ pin.log3(T_tcp[:3, :3].T @ target[:3, :3]), k,
+                                  self.s.max_angular_acceleration, dt)
         n = float(np.linalg.norm(dw))
         if n > self.s.max_angular_speed * dt:
             dw *= self.s.max_angular_speed * dt / n
