@@ -84,11 +84,11 @@ def test_controller_urdf_has_one_angle_per_continuous_joint_and_no_name_clash(tm
     and a fixed joint named like a link (Unitree Z1's 'gripperStator') renamed."""
     import xml.etree.ElementTree as ET
 
-    from robocfg.motion.reactive.controller import _urdf_without_geometry
+    from robocfg.motion.reactive.placo_urdf import urdf_without_geometry
 
     text = (DATA / "sim_onejaw.urdf").read_text().replace('joint name="palm_joint"', 'joint name="palm"')
     (tmp_path / "r.urdf").write_text(text)
-    root = ET.fromstring(_urdf_without_geometry(tmp_path / "r.urdf"))
+    root = ET.fromstring(urdf_without_geometry(tmp_path / "r.urdf"))
     joints = {j.get("name"): j for j in root.iter("joint")}
     assert joints["j1"].get("type") == joints["j6"].get("type") == "revolute"
     assert "palm" not in joints and joints["palm__fixed_joint"].get("type") == "fixed"

@@ -20,7 +20,6 @@ where it points is tracked. Frames: world, 4×4 transforms, metres.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -39,9 +38,8 @@ from robocfg.collision.shapes import (
 from robocfg.motion.reactive.collision_rows import CollisionRows
 from robocfg.motion.reactive.escape import EscapeRule, EscapeSettings
 from robocfg.motion.reactive.limits import step_bounds
+from robocfg.motion.reactive.placo_urdf import quiet_stdout, urdf_without_geometry
 from robocfg.motion.reactive.tool_roll import nearest_roll
-
-CONTINUOUS_RANGE = 1000.0  # rad: limits written on continuous joints for placo (its own joint limits are off)
 
 
 @dataclass(frozen=True)
@@ -97,47 +95,6 @@ class StepResult:
     blocked: bool  # off target (> 5 mm) with a robot–environment pair within 5 mm of the margin
 
 
-def _urdf_without_geometry(path: Path) -> str:
-    """The URDF text without ``<visual>``/``<collision>`` elements (placo then loads no meshes), fixed
-    joints named like a link renamed (Unitree's Z1 has a link and a joint ``gripperStator``), and
-    with continuous joints made revolute: pinocchio gives a continuous joint two coordinates
-    (cos, sin), this controller one angle per joint. The angle is left unwrapped (the box bounds of
-    a continuous joint are infinite), so a joint that turns past ±π keeps turning smoothly."""
-    import xml.etree.ElementTree as ET
-
-    from robocfg.assets.urdf_xml import revolute_continuous
-
-    root = ET.parse(path).getroot()
-    for link in root.iter("link"):
-        for tag in ("visual", "collision"):
-            for el in link.findall(tag):
-                link.remove(el)
-    links = {link.get("name") for link in root.iter("link")}
-    for joint in root.iter("joint"):
-        if joint.get("type") == "fixed" and joint.get("name") in links:  # placo cannot tell a link from a joint of the same name
-            joint.set("name", f"{joint.get('name')}__fixed_joint")
-    revolute_continuous(root, CONTINUOUS_RANGE)
-    return ET.tostring(root, encoding="unicode")
-
-
-@contextlib.contextmanager
-def _quiet_stdout():
-    """Silence C++ prints (placo warns on stdout while loading)."""
-    import os
-    import sys
-
-    sys.stdout.flush()
-    saved = os.dup(1)
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 1)
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-        os.close(devnull)
-
-
 def _braked(error: np.ndarray, k: float, accel: float, dt: float) -> np.ndarray:
     """The feedback step (m or rad per control period) for ``error``: ``k`` × the error, shortened so
     the speed it asks for can still brake to rest at the target with ``accel`` (m/s² or rad/s²),
@@ -159,10 +116,10 @@ class ReactiveController:
         self.arm, self.s = arm, settings
         if arm.collision is not None:  # kinematics only from the URDF (no mesh loading), our hulls
             self.robot = placo.RobotWrapper(str(arm.urdf_path), placo.Flags.ignore_collisions,
-                                            _urdf_without_geometry(arm.urdf_path))
+                                            urdf_without_geometry(arm.urdf_path))
             add_robot_geometry(self.robot.collision_model, self.robot.model, arm.collision)
         else:
-            with _quiet_stdout():
+            with quiet_stdout():
                 self.robot = placo.RobotWrapper(str(arm.urdf_path), placo.Flags.ignore_collisions)
         r = self.robot
         r.set_T_world_fbase(np.asarray(arm.base_pose, float))
