@@ -128,3 +128,26 @@ def test_cube_is_held_by_friction_only(task):
     report, _ = run_pick_place(task, episodes=1, seed=1, record=factory)
     assert report.episodes[0].success
     assert spies[0].checked > 500 and spies[0].offending == []
+
+
+@pytest.mark.parametrize(("xy", "z", "dropped"), [
+    ((0.500, 0.200), 0.0249, False),  # resting on the floor at the place point, pressed 0.1 mm into it
+    ((0.505, 0.200), 0.0265, False),  # 1.5 mm above resting, 5 mm from the point: set down
+    ((0.500, 0.200), 0.0400, True),   # 15 mm up: it fell out of the hand on the way down
+    ((0.550, 0.200), 0.0250, True),   # resting, but 5 cm from the place point
+])
+def test_lowering_counts_an_object_already_set_down_at_the_place_point_as_placed(xy, z, dropped):
+    """A one-jaw gripper's fixed jaw can leave the object as the floor takes its weight a moment
+    before the lower ends; that is a set-down, not a drop, when the object rests at the place point."""
+    from types import SimpleNamespace
+
+    from robocfg.runners.pick_place_machine import _StateMachine
+
+    cube = SimpleNamespace(below_origin=lambda R: 0.025)
+    sm = SimpleNamespace(
+        _dropped=lambda: "object dropped (2.0 cm from the TCP)", obj=7, shape=cube,
+        world=SimpleNamespace(body_pose=lambda body: (np.array([*xy, z]), np.array([0.0, 0.0, 0.0, 1.0]))),
+        setup=SimpleNamespace(place_xy=np.array([0.5, 0.2])), params=SimpleNamespace(success_tolerance=0.02),
+        _support_height=lambda xy: 0.0)
+    why = _StateMachine._dropped_before_placed(sm)  # type: ignore[arg-type]
+    assert (why is not None) == dropped
