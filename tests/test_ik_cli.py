@@ -56,7 +56,11 @@ def test_ik_bad_input_exits_2(args, capsys, monkeypatch) -> None:
 
 def test_bench_ik_writes_rows(tmp_path, capsys, monkeypatch) -> None:
     report = tmp_path / "bench.json"
+    # The protocol's 5 ms wall budget is a speed measurement: on a loaded machine (CI at load 11)
+    # LM's p95 passes it and 2 of 5 queries fail. Here the rows and their success are checked with
+    # a budget ~40x LM's p95, on this thread's CPU clock, so load cannot decide the outcome.
     code, out, _ = run_main(["bench", "ik", "--robot", "panda", "-n", "5", "--backends", "lm",
+                             "--budget-ms", "200", "--budget-clock", "cpu",
                              "--json", str(report)], capsys, monkeypatch)
     assert code == 0, out
     data = json.loads(report.read_text())
