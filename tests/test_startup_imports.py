@@ -66,6 +66,18 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     names = _imported(tmp_path, code=code)
     assert {"pybullet", "pinocchio", "robocfg.motion.cubic"} <= names  # the probe sees the episode's modules
     assert _heavy(names, [*NEVER, "scipy.interpolate", "scipy.spatial", "scipy.optimize", "scipy.sparse"]) == []
+    assert "scipy.linalg" not in names and "scipy.linalg._flapack" in names  # LAPACK without scipy.linalg
+
+
+def test_lapack_routines_are_scipys_own_functions(tmp_path) -> None:
+    """Loaded before ``scipy.linalg``, the routines are the objects scipy.linalg.lapack then
+    gives (the same results); and they solve."""
+    code = ("import numpy as np; from robocfg.geometry.lapack import lapack; import sys\n"
+            "dposv, dgtsv = lapack('dposv'), lapack('dgtsv'); assert 'scipy.linalg' not in sys.modules\n"
+            "H, g = np.array([[4.0, 1.0], [1.0, 3.0]]), np.array([1.0, 2.0])\n"
+            "assert np.allclose(H @ dposv(H, g)[1], g)\n"
+            "import scipy.linalg.lapack as l; assert l.dposv is dposv and l.dgtsv is dgtsv")
+    _imported(tmp_path, code=code)
 
 
 def test_a_mesh_object_still_loads_trimesh_on_demand() -> None:

@@ -7,7 +7,7 @@ the same arithmetic in the same order — the tridiagonal system solved by LAPAC
 ``scipy.linalg.solve_banded`` does, the Hermite coefficients, and ``PPoly``'s evaluation loop
 (``_ppoly.evaluate_poly1``: Horner-free powers, derivative prefactors) — so its values are the
 same bits as scipy's (tested against ``scipy.interpolate.CubicSpline``), and simulated runs do
-not change with it. ``scipy.linalg`` is imported (the IK already needs it).
+not change with it. LAPACK comes from scipy's wrapper (:mod:`robocfg.geometry.lapack`).
 
 Only what robocfg calls: ``x`` (k,) strictly increasing, ``y`` (k, n) along axis 0, k ≥ 4 for
 ``"not-a-knot"`` and k ≥ 2 for ``"natural"``; ``spline(s, nu)`` for ``nu`` in 0, 1, 2, 3,
@@ -96,9 +96,9 @@ class CubicSpline:
 
 def _solve_tridiagonal(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``scipy.linalg.solve_banded((1, 1), A, b)`` as scipy calls it: LAPACK ``dgtsv``."""
-    from scipy.linalg.lapack import dgtsv
+    from robocfg.geometry.lapack import lapack
 
-    _, _, _, x, info = dgtsv(A[2, :-1], A[1, :], A[0, 1:], b, 1, 1, 1, 1)
+    _, _, _, x, info = lapack("dgtsv")(A[2, :-1], A[1, :], A[0, 1:], b, 1, 1, 1, 1)
     if info != 0:
         raise np.linalg.LinAlgError("CubicSpline: singular system")
     return x

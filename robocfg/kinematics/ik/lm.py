@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg.lapack import dposv
 
+from robocfg.geometry.lapack import lapack
 from robocfg.kinematics.ik.common import (
     TWO_PI,
     finish,
@@ -32,6 +32,8 @@ from robocfg.kinematics.ik.common import (
     search,
 )
 from robocfg.kinematics.ik.registry import register
+
+dposv = lapack("dposv")  # scipy.linalg.lapack.dposv without importing scipy.linalg
 
 if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
