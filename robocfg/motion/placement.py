@@ -104,9 +104,13 @@ MEMO_SIZE = 8
 
 def resolve_placement(task: CheckedTask, arm: str | None = None) -> Placement:
     """The task's spots in world coordinates for ``arm`` and the reach problems left with them
-    (remembered for the same task document, robot and arm: ``run`` asks before and after checking)."""
+    (remembered for the same task config, robot and arm: ``run`` asks before and after checking).
+
+    The key is the task's validated config, not its YAML document: a caller may run a copy of a
+    checked task with changed parameters (``dataclasses.replace(task, config=...)``, as the API
+    and tests do), and the answer carries those parameters."""
     robot = task.robots[0].config
-    key = (str(task.path), repr(task.doc.data), repr(robot), robot.arm(arm).name, str(task.written_robot))
+    key = (str(task.path), task.config.model_dump_json(), repr(robot), robot.arm(arm).name, str(task.written_robot))
     if key not in _MEMO:
         if len(_MEMO) >= MEMO_SIZE:
             _MEMO.pop(next(iter(_MEMO)))
