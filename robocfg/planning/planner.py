@@ -11,7 +11,8 @@
 4. the path is shortened (:mod:`.shortcut`), every segment still checked.
 
 :func:`JointPlanner.timed` turns the path into a trajectory with toppra (through
-:func:`robocfg.motion.plan.plan_trajectory`) and checks the *timed* path too: a spline through the
+:func:`robocfg.motion.plan.plan_trajectory`; a single straight segment gets the synchronised
+trapezoid, time-optimal along a line, without toppra) and checks the *timed* path too: a spline through the
 waypoints can cut a corner the straight segments went around; if any sample of it is invalid, the
 path is timed with a stop at every waypoint instead (straight segments: exactly what was checked).
 
@@ -141,6 +142,9 @@ class JointPlanner:
         waypoint instead where the smooth path would cut into an obstacle."""
         from robocfg.motion.plan import plan_trajectory
 
+        if len(path.waypoints) == 2:  # one straight segment: the synchronised trapezoid is the time-optimal
+            # rest-to-rest timing along a line (toppra's would only tie it, and plan_trajectory then took it)
+            return plan_trajectory(path.waypoints, limits, stop_at_waypoints=True)
         plan = plan_trajectory(path.waypoints, limits)
         if len(path.waypoints) > 2 and plan.path != "linear" and not self.trajectory_valid(plan):
             plan = plan_trajectory(path.waypoints, limits, stop_at_waypoints=True)
