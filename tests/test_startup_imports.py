@@ -67,6 +67,9 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     assert {"pybullet", "pinocchio", "robocfg.motion.cubic"} <= names  # the probe sees the episode's modules
     assert _heavy(names, [*NEVER, "scipy.interpolate", "scipy.spatial", "scipy.optimize", "scipy.sparse"]) == []
     assert "scipy.linalg" not in names and "scipy.linalg._flapack" in names  # LAPACK without scipy.linalg
+    other_kinds = ["robocfg.runners.grasp", "robocfg.runners.trajectory", "robocfg.runners.follow_target",
+                   "robocfg.runners.gripper", "robocfg.runners.pick_place_many"]
+    assert [m for m in other_kinds if m in names] == []  # the registry loaded this kind's runner only
 
 
 def test_lapack_routines_are_scipys_own_functions(tmp_path) -> None:
