@@ -64,14 +64,14 @@ class Cell:
 
 
 def task_file(folder: Path, robot: str, name: str, task: str = "pick_place") -> Path:
-    """The pick-place task ``task`` (default: the default one) with its first robot and its object
-    replaced (nothing else)."""
+    """The pick-place task ``task`` (default: the default one) with its object replaced (nothing
+    else). The robot is given as ``--robot`` gives it (``load_task(robot_override=...)``), so the
+    file still names the robot its spots were written for and ``placement: auto`` maps them."""
     import yaml
 
     from robocfg.config import catalog
 
     data = yaml.safe_load(catalog.find("tasks", task).read_text())
-    data["robots"][0]["robot"] = robot
     old = data["pick_place"]["object"]
     data["pick_place"]["object"] = {"name": name, "position": old["position"], "euler_deg": [0.0, 0.0, 0.0],
                                     "color": old["color"], **OBJECTS[name]}
@@ -87,18 +87,18 @@ def run_cell(args: tuple[str, str, int, int, str, str]) -> Cell:
     quiet_import()
     from robocfg.checks import load_task
     from robocfg.errors import ConfigError
-    from robocfg.motion.reach import pick_place_reach
+    from robocfg.motion.placement import resolve_placement
     from robocfg.runners.pick_place import run_pick_place
 
     cell = Cell(robot, name)
     t0 = time.perf_counter()
     try:
-        task = load_task(task_file(Path(folder), robot, name, task_name))
+        task = load_task(task_file(Path(folder), robot, name, task_name), robot_override=robot)
     except ConfigError as exc:
         cell.rejected = "; ".join(f"{p.path}: {p.message}" for p in exc.problems if p.severity == "error")
         return cell
     too_wide = [w for w in task.warnings if "narrowest horizontal side" in w.message]
-    unreachable = [r for r in pick_place_reach(task) if r.nominal]
+    unreachable = [r for r in resolve_placement(task).reach if r.nominal]  # as ``run`` checks it
     if too_wide or unreachable:
         cell.rejected = too_wide[0].message if too_wide else f"{unreachable[0].phase}: {unreachable[0].reason}"
         return cell
