@@ -46,26 +46,31 @@ class SceneQueries:
         """Every body (link) the segment ``start`` → ``end`` passes through, nearest first.
 
         A PyBullet ray reports its closest hit only, so after each hit the ray is cast again from
-        just beyond the far side of the hit link's bounding box (an object resting on a fixture
-        would otherwise hide the fixture)."""
+        just past that hit point (an object resting on a fixture would otherwise hide the fixture);
+        a ray starting inside a convex shape does not report it, and further hits on the same link
+        (another convex part of a decomposed mesh) are stepped over. Restarting past the hit link's
+        bounding box instead skipped thin supports: a mesh's box carries Bullet's collision margin
+        and reached through the top of a 5 cm stand under it."""
         a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         length = float(np.linalg.norm(b - a))
         if length == 0.0:
             return []
         d = (b - a) / length
         hits: list[RayHit] = []
+        seen: set[tuple[int, int]] = set()
         s = a
-        for _ in range(max_hits):
+        for _ in range(4 * max_hits):
             h = p.rayTest(list(s), list(b), physicsClientId=self.client)[0]
             if h[0] < 0:
                 break
-            hits.append(RayHit(int(h[0]), tuple(h[3])))
-            lo, hi = p.getAABB(h[0], h[1], physicsClientId=self.client)
-            exits = [((hi[k] if d[k] > 0 else lo[k]) - s[k]) / d[k] for k in range(3) if abs(d[k]) > 1e-12]
-            t = max(min(exits), 0.0) + 1e-4
-            if float(np.dot(s + t * d - a, d)) >= length:
+            if (h[0], h[1]) not in seen:
+                seen.add((h[0], h[1]))
+                hits.append(RayHit(int(h[0]), tuple(h[3])))
+                if len(hits) >= max_hits:
+                    break
+            s = np.asarray(h[3], dtype=float) + 1e-4 * d
+            if float(np.dot(s - a, d)) >= length:
                 break
-            s = s + t * d
         return hits
 
     def closest_points(self, a: str | int, b: str | int, max_distance: float) -> list[PairPoint]:
