@@ -46,10 +46,11 @@ class SceneQueries:
         """Every body (link) the segment ``start`` → ``end`` passes through, nearest first.
 
         A PyBullet ray reports its closest hit only, so after each hit the ray is cast again from
-        just past that hit point (an object resting on a fixture would otherwise hide the fixture);
-        a ray starting inside a convex shape does not report it, and further hits on the same link
-        (another convex part of a decomposed mesh) are stepped over. Restarting past the hit link's
-        bounding box instead skipped thin supports: a mesh's box carries Bullet's collision margin
+        just past that hit point (an object resting on a fixture would otherwise hide the fixture).
+        A ray starting inside a shape may report that shape again at its start (primitive links of
+        a robot do; a decomposed mesh's convex parts do not): while the same link answers, the step
+        past the hit doubles from 0.1 mm, never beyond the link's bounding box. Restarting past the
+        bounding box at once skipped thin supports: a mesh's box carries Bullet's collision margin
         and reached through the top of a 5 cm stand under it."""
         a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         length = float(np.linalg.norm(b - a))
@@ -58,17 +59,23 @@ class SceneQueries:
         d = (b - a) / length
         hits: list[RayHit] = []
         seen: set[tuple[int, int]] = set()
-        s = a
-        for _ in range(4 * max_hits):
+        s, step, last = a, 1e-4, (-1, -1)
+        for _ in range(8 * max_hits):
             h = p.rayTest(list(s), list(b), physicsClientId=self.client)[0]
             if h[0] < 0:
                 break
-            if (h[0], h[1]) not in seen:
-                seen.add((h[0], h[1]))
-                hits.append(RayHit(int(h[0]), tuple(h[3])))
+            key = (int(h[0]), int(h[1]))
+            step = 2.0 * step if key == last else 1e-4
+            last = key
+            if key not in seen:
+                seen.add(key)
+                hits.append(RayHit(key[0], tuple(h[3])))
                 if len(hits) >= max_hits:
                     break
-            s = np.asarray(h[3], dtype=float) + 1e-4 * d
+            hit = np.asarray(h[3], dtype=float)
+            lo, hi = p.getAABB(h[0], h[1], physicsClientId=self.client)
+            exits = [((hi[k] if d[k] > 0 else lo[k]) - hit[k]) / d[k] for k in range(3) if abs(d[k]) > 1e-12]
+            s = hit + min(step, max(min(exits), 0.0) + 1e-4) * d
             if float(np.dot(s - a, d)) >= length:
                 break
         return hits
