@@ -163,14 +163,21 @@ def test_unknown_command_arguments_exit_2_without_traceback():
     assert "did you mean 'panda'?" in r.stderr and "Traceback" not in r.stderr
 
 
-def test_debug_shows_traceback(capsys, monkeypatch):
+def test_debug_shows_traceback_for_its_own_command_line_only(capsys, monkeypatch):
     monkeypatch.chdir(ROOT)
-    monkeypatch.setenv("ROBOCFG_DEBUG", "0")  # --debug sets it to 1; undone after the test, so later subprocesses don't inherit it
+    monkeypatch.delenv("ROBOCFG_DEBUG", raising=False)
     monkeypatch.setattr(sys, "argv", ["robocfg", "--debug", "inspect", "pnda"])
     from robocfg.errors import NotFound
 
     with pytest.raises(NotFound):
         main()
+    # --debug is not left in the environment: child processes and the next in-process call
+    # (the same command line without --debug) get the plain message, exit 2.
+    import os
+
+    assert "ROBOCFG_DEBUG" not in os.environ
+    code, _, err = run_main(["inspect", "pnda"], capsys, monkeypatch)
+    assert code == 2 and "did you mean 'panda'?" in err and "Traceback" not in err
 
 
 # ---------------------------------------------------------------- inspect

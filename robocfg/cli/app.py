@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import sys
 
 import typer
@@ -61,10 +60,9 @@ def _root(
     version: bool = typer.Option(False, "--version", help="Print the version and exit.",
                                  callback=_print_version, is_eager=True),
 ) -> None:
-    if debug:
-        os.environ["ROBOCFG_DEBUG"] = "1"
     from robocfg.cli import common
 
+    common.set_debug(debug)
     common._stdout_taken = False  # set again by ``--json -`` while this command line is parsed
 
 
@@ -85,11 +83,10 @@ app.add_typer(dataset.dataset_app, name="dataset")
 
 def main() -> None:
     """Console-script entry point."""
-    from robocfg.cli.common import debug_enabled
+    from robocfg.cli.common import debug_enabled, set_debug
     from robocfg.cli.errors import describe
 
-    if "--debug" in sys.argv[1:]:
-        os.environ["ROBOCFG_DEBUG"] = "1"
+    set_debug("--debug" in sys.argv[1:])
     try:
         rv = app(standalone_mode=False)
         sys.exit(rv if isinstance(rv, int) else 0)

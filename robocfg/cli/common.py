@@ -69,8 +69,20 @@ RecordOpt = Annotated[Path | None, typer.Option("--record", parser=_record_path,
 SeedOpt = Annotated[int | None, typer.Option("--seed", min=0, help="Random seed, >= 0 (overrides the task's sim.seed).")]
 
 
+_debug_flag = False  # set by ``--debug`` for this command line only (see ``set_debug``)
+
+
+def set_debug(on: bool) -> None:
+    """Show tracebacks for the command line being run. A flag in this module, not an environment
+    variable: ``--debug`` given to one in-process call (``app([...])``, the Python API's tests)
+    must not leak into the next call or into child processes' environments."""
+    global _debug_flag
+    _debug_flag = on
+
+
 def debug_enabled() -> bool:
-    return os.environ.get("ROBOCFG_DEBUG", "") not in ("", "0")
+    """``--debug`` on this command line, or ``ROBOCFG_DEBUG`` set (non-empty, not 0) by the user."""
+    return _debug_flag or os.environ.get("ROBOCFG_DEBUG", "") not in ("", "0")
 
 
 def console(stderr: bool = False):
