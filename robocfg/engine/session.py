@@ -76,6 +76,9 @@ class EpisodeSession(ABC, Generic[RecordT]):
     # restore: Bullet's overlapping-pair order follows the bodies removed and re-added before, which
     # moves objects standing close together by micrometres (clear_table). Costs one build per episode.
     fresh_world_per_episode: bool = False
+    # True: the kind's episodes take pictures of the world themselves (grasp perception's depth
+    # camera), so its robots always load their visual meshes (see :meth:`draws`).
+    takes_pictures: bool = False
 
     def __init__(self, task: CheckedTask, options: RunOptions, timing: BatchTiming | None = None):
         self.task, self.options = task, options
@@ -89,7 +92,7 @@ class EpisodeSession(ABC, Generic[RecordT]):
     def _build_world(self) -> None:
         from robocfg.sim.world import World
 
-        self.world: World = World(self.task, gui=self.options.gui)
+        self.world: World = World(self.task, gui=self.options.gui, visuals=self.draws())
         try:
             self.world.step(1)
             self.prepare()
@@ -97,6 +100,15 @@ class EpisodeSession(ABC, Generic[RecordT]):
         except BaseException:
             self.world.close()
             raise
+
+    def draws(self) -> bool:
+        """Whether anything draws this session's world, so its robots need their visual meshes:
+        the GUI, a picture recording (``record`` or a custom ``recorder``), a dataset sink when the
+        task declares cameras, or a kind that ``takes_pictures``. Otherwise the world loads without
+        them (the same physics; :class:`~robocfg.sim.world.World`'s ``visuals``)."""
+        o = self.options
+        return (o.gui or o.record is not None or o.recorder is not None or self.takes_pictures
+                or (o.sink is not None and bool(self.task.config.cameras)))
 
     # ---- what a kind provides --------------------------------------------------------------
     def prepare(self) -> None:

@@ -51,6 +51,7 @@ class GraspSession(EpisodeSession[GraspEpisode]):
 
     # "settle": the spawned object comes to rest and is perceived; "recover": back home after a failed attempt
     phases = ("settle", "pre_grasp", "approach", "grasp", "lift", "shake", "recover")
+    takes_pictures = True  # perception's depth camera sees the robot as drawn
 
     def __init__(self, task, options: RunOptions, on_cloud: Callable[[Any], None] | None = None):
         self.on_cloud = on_cloud  # called with the first processed object cloud

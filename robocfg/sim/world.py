@@ -55,10 +55,16 @@ class World(SceneQueries):
     queries (ray casts, contacts, closest points, AABBs, dynamics) come from ``SceneQueries``."""
 
     def __init__(self, task: CheckedTask, gui: bool = False, max_joint_velocity: float = MAX_JOINT_VELOCITY,
-                 max_body_speed: float = MAX_BODY_SPEED, check_interval: float = CHECK_INTERVAL):
+                 max_body_speed: float = MAX_BODY_SPEED, check_interval: float = CHECK_INTERVAL,
+                 visuals: bool = True):
         self.task = task
         cfg = task.config
         self.gui = gui or cfg.sim.gui
+        # False: robots load without their URDF visual meshes (PyBullet's URDF_IGNORE_VISUAL_SHAPES;
+        # TinyRenderer then draws their collision shapes): for worlds nothing draws. Physics is the
+        # same (collision shapes, masses and inertias come from the rest of the URDF); loading the
+        # Panda's 9 MB of visual OBJs costs ≈ 0.2–0.4 s a process. The GUI always loads them.
+        self.visuals: bool = visuals or self.gui
         self.dt: float = cfg.sim.timestep
         self.t: float = 0.0
         self.steps = 0
@@ -137,6 +143,8 @@ class World(SceneQueries):
     def _load_robot(self, checked: CheckedRobot, mount: RobotMount) -> RobotHandle:
         c, phys = self.client, checked.config.physics
         flags = p.URDF_USE_INERTIA_FROM_FILE
+        if not self.visuals:
+            flags |= p.URDF_IGNORE_VISUAL_SHAPES
         if phys.self_collision:
             flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_EXCLUDE_ALL_PARENTS
         body = load_robot_urdf(c, checked, mount.position, mount.quaternion_xyzw(), flags)
