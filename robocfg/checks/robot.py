@@ -33,6 +33,9 @@ class CheckedRobot:
     urdf: Urdf
     warnings: list[Problem] = field(default_factory=list)
     sources: tuple[Path, ...] = ()  # the URDFs composed into urdf_path (robot + attachments), if any
+    # pad_gap_curve answers by arm (the config check, the gripper and the pick-place session ask)
+    _pad_curves: dict[str, tuple[np.ndarray, np.ndarray] | None] = field(default_factory=dict, init=False, repr=False,
+                                                                       compare=False)
 
     @property
     def path(self) -> Path:
@@ -62,12 +65,18 @@ class CheckedRobot:
         g = arm.gripper
         if not isinstance(g, ParallelGripperConfig):
             return None
-        try:
-            return width_curve(self.urdf, Resolver(self.path.parent, self.config.package_dirs), arm.ee_link,
-                               AXIS_INDEX[arm.ee_axis], list(g.finger_links), self.gripper_joints(arm),
-                               g.open, g.closed, closing_axis(arm.R_ee_graspnet))
-        except (FingerGeometryMissing, KeyError, ValueError):
-            return None
+        key = repr(arm)  # computed once per arm config (≈ 0.06 s; asked up to 3 times before an episode)
+        if key not in self._pad_curves:
+            try:
+                s, gaps = width_curve(self.urdf, Resolver(self.path.parent, self.config.package_dirs), arm.ee_link,
+                                      AXIS_INDEX[arm.ee_axis], list(g.finger_links), self.gripper_joints(arm),
+                                      g.open, g.closed, closing_axis(arm.R_ee_graspnet))
+                s.setflags(write=False)  # shared by every caller
+                gaps.setflags(write=False)
+                self._pad_curves[key] = (s, gaps)
+            except (FingerGeometryMissing, KeyError, ValueError):
+                self._pad_curves[key] = None
+        return self._pad_curves[key]
 
     def mimic_followers(self, leaders: list[str]) -> list[str]:
         return [j.name for j in self.urdf.joints.values() if j.mimic is not None and j.mimic.joint in leaders]

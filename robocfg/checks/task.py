@@ -6,10 +6,10 @@ import copy
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
-from pydantic import TypeAdapter
+from pydantic import TypeAdapter, ValidationError
 
 from robocfg.checks.grip_force import check_grip_force
 from robocfg.checks.object_fit import check_object_fit
@@ -47,6 +47,21 @@ def task_adapter() -> TypeAdapter[TaskBase]:
     if _TASK_ADAPTER is None or _TASK_ADAPTER[0] != kinds:
         _TASK_ADAPTER = (kinds, TypeAdapter(task_union()))
     return _TASK_ADAPTER[1]
+
+
+def _validate_task(doc: YamlDocument) -> TaskConfig:
+    """``doc`` validated against the model of the kind its ``task:`` names (the member the union
+    would pick, so the same result) without building the whole union's validator (every kind's
+    models: ≈ 0.08 s of a process's start); an invalid document is validated by the union, so its
+    problems read as they always did."""
+    kind = doc.data.get("task") if isinstance(doc.data, dict) else None
+    model = TASK_MODELS.get(kind) if isinstance(kind, str) else None
+    if model is not None:
+        try:
+            return cast("TaskConfig", model.model_validate(doc.data))  # every kind's model is a TaskConfig member
+        except ValidationError:
+            pass  # reported by the union below
+    return validate_document(doc, task_adapter())
 
 
 @dataclass
@@ -177,7 +192,7 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
         first.pop("robot_config_file", None)
         first["robot"] = robot_override
         doc.data["robots"][0] = first
-    config = validate_document(doc, task_adapter())
+    config = _validate_task(doc)
     problems: list[Problem] = []
     robots: list[CheckedRobot] = []
     for i, mount in enumerate(config.robots):

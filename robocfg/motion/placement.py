@@ -110,7 +110,7 @@ def resolve_placement(task: CheckedTask, arm: str | None = None) -> Placement:
     checked task with changed parameters (``dataclasses.replace(task, config=...)``, as the API
     and tests do), and the answer carries those parameters."""
     robot = task.robots[0].config
-    key = (str(task.path), task.config.model_dump_json(), repr(robot), robot.arm(arm).name, str(task.written_robot))
+    key = (str(task.path), repr(task.config), repr(robot), robot.arm(arm).name, str(task.written_robot))
     if key not in _MEMO:
         if len(_MEMO) >= MEMO_SIZE:
             _MEMO.pop(next(iter(_MEMO)))

@@ -1,0 +1,53 @@
+"""Work a process does once before its first episode, not again: a behaviour check of the start-up
+(benchmarks/bench_startup.py measures its time; no wall-clock assert here)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import robocfg.assets.fingers as fingers
+from robocfg.checks.task import load_task
+from robocfg.config import catalog
+from robocfg.engine import RunOptions, open_session
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_a_valid_task_is_validated_without_building_every_kinds_validator() -> None:
+    """The task's own kind validates it (the member the union would pick); the union of every kind
+    is built only to report an invalid document."""
+    code = ("import robocfg.checks.task as t; from robocfg.config import catalog\n"
+            "t.load_task(catalog.find('tasks', 'pick_place')); assert t._TASK_ADAPTER is None, 'union built'\n"
+            "from robocfg.config.load import load_yaml\n"
+            "doc = load_yaml(catalog.find('tasks', 'pick_place')); doc.data['pick_place']['lift_hieght'] = 0.1\n"
+            "from robocfg.errors import ConfigError\n"
+            "try:\n    t.check_task_document(doc)\nexcept ConfigError as e:\n    print(e.problems[0].message)\n"
+            "assert t._TASK_ADAPTER is not None")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert "unknown key 'lift_hieght'" in out.stdout and "did you mean 'lift_height'" in out.stdout
+
+
+def test_the_pad_gap_curve_is_computed_once_per_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The task check, the gripper and the pick-place session all ask for it; one FK sweep."""
+    calls = []
+    real = fingers.width_curve
+
+    def counted(*a, **k):
+        calls.append(1)
+        return real(*a, **k)
+
+    monkeypatch.setattr(fingers, "width_curve", counted)
+    task = load_task(catalog.find("tasks", "pick_place"))
+    s = open_session(task, RunOptions(seed=0))
+    try:
+        assert s.tools.pad_force is not None and s.handle.gripper is not None
+        assert len(calls) == 1
+        s2 = s.task.robots[0].pad_gap_curve(s.arm_cfg)
+        assert s2 is not None and not s2[1].flags.writeable  # shared, so nobody may change it
+    finally:
+        s.close()
