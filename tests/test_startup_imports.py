@@ -18,6 +18,10 @@ ROOT = Path(__file__).resolve().parents[1]
 NEVER = ["ray", "pyarrow", "av", "h5py", "ompl", "toppra", "matplotlib", "imageio", "trimesh", "networkx",
          "gymnasium", "viser", "placo", "pink", "yourdfpy", "PIL"]
 
+# the built-in runners other than pick-place's
+OTHER_KINDS = ["robocfg.runners.grasp", "robocfg.runners.trajectory", "robocfg.runners.follow_target",
+               "robocfg.runners.gripper", "robocfg.runners.pick_place_many"]
+
 
 def _imported(tmp_path: Path, cli: list[str] | None = None, code: str | None = None) -> set[str]:
     """Every module in ``sys.modules`` when a fresh ``robocfg CLI...`` process (or ``python -c
@@ -47,6 +51,12 @@ def test_run_kind_help_imports_no_simulator_kinematics_or_scipy(tmp_path) -> Non
     names = _imported(tmp_path, ["run", "pick-place", "--help"])
     assert "robocfg.runners.pick_place" in names  # the kind's options come from its runner
     assert _heavy(names, [*NEVER, "scipy", "pybullet", "pinocchio"]) == []
+    assert [m for m in OTHER_KINDS if m in names] == []  # that kind's runner only
+
+
+def test_run_help_lists_every_kind(tmp_path) -> None:
+    names = _imported(tmp_path, ["run", "--help"])
+    assert {"robocfg.runners.pick_place", *OTHER_KINDS} <= names
 
 
 def test_validating_a_pick_place_of_a_box_imports_no_trimesh(tmp_path) -> None:
@@ -67,9 +77,7 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     assert {"pybullet", "pinocchio", "robocfg.motion.cubic"} <= names  # the probe sees the episode's modules
     assert _heavy(names, [*NEVER, "scipy.interpolate", "scipy.spatial", "scipy.optimize", "scipy.sparse"]) == []
     assert "scipy.linalg" not in names and "scipy.linalg._flapack" in names  # LAPACK without scipy.linalg
-    other_kinds = ["robocfg.runners.grasp", "robocfg.runners.trajectory", "robocfg.runners.follow_target",
-                   "robocfg.runners.gripper", "robocfg.runners.pick_place_many"]
-    assert [m for m in other_kinds if m in names] == []  # the registry loaded this kind's runner only
+    assert [m for m in OTHER_KINDS if m in names] == []  # the registry loaded this kind's runner only
 
 
 def test_lapack_routines_are_scipys_own_functions(tmp_path) -> None:

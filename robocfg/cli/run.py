@@ -1,6 +1,7 @@
 """``robocfg run KIND``: one sub-command per registered task kind, made by one factory
 (``robocfg.cli.run_command``). The kinds load when ``run`` itself is used, so ``robocfg --help``
-and ``robocfg validate`` stay fast."""
+and ``robocfg validate`` stay fast; ``robocfg run KIND`` (and its ``--help``) loads that kind's
+runner only, ``robocfg run --help`` (the list) loads them all."""
 
 from __future__ import annotations
 
@@ -13,27 +14,48 @@ from typer.core import TyperGroup
 class _KindsGroup(TyperGroup):
     """The ``run`` group: its commands come from the task registry on first use."""
 
-    _kinds_loaded = False
+    _all_loaded = False
+
+    def _add(self, kind: str, runner: Any) -> Any:
+        from robocfg.cli.help_style import polish
+        from robocfg.cli.run_command import make_command
+        from robocfg.engine.registry import command_name
+
+        sub = typer.Typer(add_completion=False, rich_markup_mode=None)
+        fn = make_command(runner)
+        sub.command(command_name(kind), help=fn.__doc__)(fn)
+        cmd = self.commands[command_name(kind)] = typer.main.get_command(sub)
+        polish(cmd)  # loaded after the root polished the tree
+        return cmd
 
     def _commands(self) -> Any:
-        if not self._kinds_loaded:
-            from robocfg.cli.help_style import polish
-            from robocfg.cli.run_command import make_command
+        if not self._all_loaded:
             from robocfg.engine.registry import command_name, registered
 
-            for kind, runner in registered().items():
-                sub = typer.Typer(add_completion=False, rich_markup_mode=None)
-                fn = make_command(runner)
-                sub.command(command_name(kind), help=fn.__doc__)(fn)
-                self.commands[command_name(kind)] = typer.main.get_command(sub)
-                polish(self.commands[command_name(kind)])  # loaded after the root polished the tree
-            self._kinds_loaded = True
+            kinds = registered()
+            made = {name: self.commands.pop(name) for name in list(self.commands)}
+            for kind, runner in kinds.items():  # in the registry's order, whichever were made first
+                name = command_name(kind)
+                if name in made:
+                    self.commands[name] = made[name]
+                else:
+                    self._add(kind, runner)
+            self._all_loaded = True
         return self.commands
 
     def list_commands(self, ctx: Any) -> list[str]:
         return list(self._commands())
 
     def get_command(self, ctx: Any, cmd_name: str) -> Any:
+        from robocfg.engine.registry import builtin_kind
+
+        if cmd_name in self.commands:
+            return self.commands[cmd_name]
+        kind = builtin_kind(cmd_name)  # a built-in kind: its runner alone
+        if kind is not None and not self._all_loaded:
+            from robocfg.engine.registry import runner_for
+
+            return self._add(kind, runner_for(kind))
         return self._commands().get(cmd_name)
 
 

@@ -96,6 +96,13 @@ def registered() -> dict[str, type[TaskRunner]]:
     return builtin | {k: v for k, v in _REGISTRY.items() if k not in builtin}
 
 
+def builtin_kind(name: str) -> str | None:
+    """The built-in kind whose ``robocfg run`` sub-command is ``name`` (``pick-place`` →
+    ``pick_place``), loading nothing; None for any other name."""
+    kind = name.replace("-", "_")
+    return kind if kind in _BUILTIN_KINDS and command_name(kind) == name else None
+
+
 def command_name(kind: str) -> str:
     """The ``robocfg run`` sub-command of a kind: ``pick_place`` → ``pick-place``."""
     return kind.replace("_", "-")
