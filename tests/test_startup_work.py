@@ -51,3 +51,35 @@ def test_the_pad_gap_curve_is_computed_once_per_process(monkeypatch: pytest.Monk
         assert s2 is not None and not s2[1].flags.writeable  # shared, so nobody may change it
     finally:
         s.close()
+
+
+@pytest.mark.parametrize("robot", sorted((ROOT / "robocfg" / "data" / "robots").glob("*.yaml")), ids=lambda r: r.stem)
+def test_pad_gap_curve_with_the_chain_memo_is_bit_identical(robot: Path) -> None:
+    """``width_curve`` keeps Urdf.link_pose's chain products over its sweep: the same gaps, bit
+    for bit, as every pose computed from the root (the gripper's width commands depend on them)."""
+    import numpy as np
+
+    from robocfg.assets.fingers import closing_axis, finger_points, pad_gap, pad_points, width_curve
+    from robocfg.assets.paths import Resolver
+    from robocfg.checks.robot import load_robot
+    from robocfg.config.robot import ParallelGripperConfig
+    from robocfg.config.types import AXIS_INDEX
+
+    checked = load_robot(robot)
+    arms = [a for a in checked.config.arms if isinstance(a.gripper, ParallelGripperConfig)]
+    if not arms:
+        pytest.skip("no parallel gripper")
+    for arm in arms:
+        g = arm.gripper
+        assert isinstance(g, ParallelGripperConfig)
+        resolver = Resolver(checked.path.parent, checked.config.package_dirs)
+        args = (checked.urdf, resolver, arm.ee_link, AXIS_INDEX[arm.ee_axis], list(g.finger_links),
+                checked.gripper_joints(arm), g.open, g.closed, closing_axis(arm.R_ee_graspnet))
+        s, gaps = width_curve(*args)
+        points = finger_points(checked.urdf, resolver, list(g.finger_links))
+        qo, qc = np.asarray(g.open, float), np.asarray(g.closed, float)
+        leaders = checked.gripper_joints(arm)
+        plain = np.array([pad_gap(pad_points(checked.urdf, arm.ee_link, list(g.finger_links), points,
+                                             dict(zip(leaders, qc + k * (qo - qc), strict=True)), AXIS_INDEX[arm.ee_axis]),
+                                  closing_axis(arm.R_ee_graspnet)) for k in s])
+        assert gaps.tobytes() == plain.tobytes() and np.ptp(gaps) > 0

@@ -47,12 +47,13 @@ def finger_points(urdf: Urdf, resolver: Resolver, finger_links: list[str]) -> li
 
 
 def pad_points(urdf: Urdf, ee_link: str, finger_links: list[str], points: list[np.ndarray],
-               q: dict[str, float], axis: int) -> list[np.ndarray]:
-    """Pad points of each finger in the ``ee_link`` frame at gripper joint values ``q``."""
-    T_ee_inv = np.linalg.inv(urdf.link_pose(ee_link, q))
+               q: dict[str, float], axis: int, memo: dict | None = None) -> list[np.ndarray]:
+    """Pad points of each finger in the ``ee_link`` frame at gripper joint values ``q``
+    (``memo``: :meth:`Urdf.link_pose`'s, kept over a sweep of ``q``)."""
+    T_ee_inv = np.linalg.inv(urdf.link_pose(ee_link, q, memo))
     out = []
     for name, P in zip(finger_links, points, strict=True):
-        T = T_ee_inv @ urdf.link_pose(name, q)
+        T = T_ee_inv @ urdf.link_pose(name, q, memo)
         P_ee = P @ T[:3, :3].T + T[:3, 3]
         tip, base = P_ee[:, axis].max(), P_ee[:, axis].min()
         if tip - base <= 2 * PAD_LENGTH:
@@ -92,7 +93,8 @@ def width_curve(urdf: Urdf, resolver: Resolver, ee_link: str, ee_axis: int, fing
     points = finger_points(urdf, resolver, finger_links)
     qo, qc = np.asarray(q_open, float), np.asarray(q_closed, float)
     s = np.linspace(0.0, 1.0, n)
+    memo: dict = {}  # the arm's chain to the hand is the same at every s
     gaps = np.array([pad_gap(pad_points(urdf, ee_link, finger_links, points,
-                                        dict(zip(leaders, qc + k * (qo - qc), strict=True)), ee_axis), closing)
+                                        dict(zip(leaders, qc + k * (qo - qc), strict=True)), ee_axis, memo), closing)
                      for k in s])
     return s, gaps

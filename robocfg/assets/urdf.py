@@ -111,14 +111,31 @@ class Urdf:
             cur = j.parent
         return out[::-1]
 
-    def link_pose(self, link: str, q: dict[str, float] | None = None) -> np.ndarray:
+    def link_pose(self, link: str, q: dict[str, float] | None = None, memo: dict | None = None) -> np.ndarray:
         """4x4 pose of ``link`` in the root link frame for joint positions ``q`` (missing → 0;
-        mimic followers follow their leader)."""
+        mimic followers follow their leader).
+
+        ``memo``: a dict the caller keeps across calls for one URDF (a sweep over gripper
+        positions): the product over each chain prefix with the same joint values is computed
+        once, by the same operations in the same order, so the poses are bit-for-bit the ones
+        computed without it."""
         q = dict(q or {})
         T = np.eye(4)
-        for j in self.chain(self.root, link) or []:
-            T = T @ j.origin @ joint_motion(j, self.joint_value(j, q))
-        return T
+        if memo is None:
+            for j in self.chain(self.root, link) or []:
+                T = T @ j.origin @ joint_motion(j, self.joint_value(j, q))
+            return T
+        chain = memo.get(link)
+        if chain is None:
+            chain = memo[link] = tuple(self.chain(self.root, link) or [])
+        key: tuple = ()
+        for j in chain:
+            key += (j.name, self.joint_value(j, q))
+            hit = memo.get(key)
+            if hit is None:
+                hit = memo[key] = T @ j.origin @ joint_motion(j, key[-1])
+            T = hit
+        return T.copy()
 
     def joint_value(self, j: Joint, q: dict[str, float]) -> float:
         if j.mimic is not None and j.name not in q:
