@@ -77,7 +77,8 @@ def test_pick_place_episode_is_the_same_without_visual_meshes() -> None:
 
 @pytest.mark.parametrize("robot", SHIPPED_ROBOTS, ids=lambda r: r.stem)
 def test_every_robot_has_the_same_dynamics_and_shapes_without_visuals(tmp_path, robot) -> None:
-    """Masses, inertias, friction, collision shapes and 60 steps of a moving arm are identical."""
+    """Masses, inertias, friction, collision shapes (the robot's and the ground's) and 60 steps
+    of a moving arm are identical."""
     task = make_task(tmp_path, robot)
     states = []
     for visuals in (True, False):
@@ -86,6 +87,8 @@ def test_every_robot_has_the_same_dynamics_and_shapes_without_visuals(tmp_path, 
             links = range(-1, p.getNumJoints(body, physicsClientId=c))
             facts = [(p.getDynamicsInfo(body, li, physicsClientId=c), p.getCollisionShapeData(body, li, physicsClientId=c),
                       p.getAABB(body, li, physicsClientId=c)) for li in links]
+            g = w.bodies["ground"]  # the plane loads without its textured mesh too
+            facts.append((p.getDynamicsInfo(g, -1, physicsClientId=c), p.getCollisionShapeData(g, -1, physicsClientId=c)))
             arm = w.robot.arm()
             arm.command(np.asarray(arm.home, float) + 0.2)
             w.step(60)

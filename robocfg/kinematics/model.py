@@ -19,6 +19,7 @@ positions, Jacobians, IK dispatch); the IK solvers themselves live in :mod:`robo
 from __future__ import annotations
 
 import math
+import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -39,17 +40,27 @@ if TYPE_CHECKING:
 TCP_FRAME = "tcp"
 
 
-def _urdf_xml_without_continuous(path: str) -> tuple[str, set[str]]:
+_XML_MEMO: dict[tuple[str, int, int], tuple[str, frozenset[str]]] = {}
+
+
+def _urdf_xml_without_continuous(path: str) -> tuple[str, frozenset[str]]:
     """The URDF text with continuous joints turned into revolute ones limited to [-π, π].
 
     pinocchio models continuous joints with two coordinates (cos, sin); one angle per joint keeps
-    the interface simple. Returns (xml text, names of the converted joints).
+    the interface simple. Returns (xml text, names of the converted joints); remembered per file
+    (path, size, mtime): a process builds several models of one robot before its first episode.
     """
     from robocfg.assets.urdf_xml import read_urdf_xml, revolute_continuous
 
-    root = read_urdf_xml(path)
-    converted = revolute_continuous(root, math.pi)
-    return ET.tostring(root, encoding="unicode"), converted
+    st = os.stat(path)
+    key = (path, st.st_size, st.st_mtime_ns)
+    if key not in _XML_MEMO:
+        if len(_XML_MEMO) >= 16:
+            _XML_MEMO.pop(next(iter(_XML_MEMO)))
+        root = read_urdf_xml(path)
+        converted = revolute_continuous(root, math.pi)
+        _XML_MEMO[key] = (ET.tostring(root, encoding="unicode"), frozenset(converted))
+    return _XML_MEMO[key]
 
 
 @dataclass

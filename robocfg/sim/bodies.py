@@ -94,9 +94,11 @@ def spawn_body(client: int, body: Body, base_dir: Path, static: bool = False, ca
     return bid
 
 
-def spawn_ground(client: int) -> int:
-    """pybullet_data's plane.urdf at z = 0."""
-    return p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), useFixedBase=True, physicsClientId=client)
+def spawn_ground(client: int, visuals: bool = True) -> int:
+    """pybullet_data's plane.urdf at z = 0 (``visuals=False``: without its textured mesh, for a
+    world nothing draws; the collision box is the same)."""
+    return p.loadURDF(str(Path(pybullet_data.getDataPath()) / "plane.urdf"), useFixedBase=True,
+                      flags=0 if visuals else p.URDF_IGNORE_VISUAL_SHAPES, physicsClientId=client)
 
 
 def spawn_table(client: int, table: Table) -> list[int]:

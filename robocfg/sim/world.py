@@ -119,7 +119,7 @@ class World(SceneQueries):
         p.setPhysicsEngineParameter(fixedTimeStep=self.dt, numSolverIterations=iters, physicsClientId=c)
         scene, base_dir = cfg.scene, self.task.path.parent
         if scene.ground:
-            self.bodies["ground"] = spawn_ground(c)
+            self.bodies["ground"] = spawn_ground(c, self.visuals)
         if scene.table is not None:
             ids = spawn_table(c, scene.table)
             self.bodies["table"] = ids[0]
