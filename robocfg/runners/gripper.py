@@ -68,7 +68,7 @@ def run_gripper(task: CheckedTask, gui: bool = False, record: Path | None = None
     if g_cfg is None:
         raise RobocfgError(f"robot {robot_cfg.name!r} has no gripper (arm {arm_cfg.name!r} gripper is missing in {task.robots[0].path})")
     t_wall = time.perf_counter()
-    with World(task, gui=gui) as world:
+    with World(task, gui=gui, visuals=record is not None) as world:  # visual meshes only to film
         world.should_stop = should_stop
         result = GripperResult(
             task=str(task.path), robot=robot_cfg.name, arm=arm_cfg.name, gripper_type=g_cfg.type,
