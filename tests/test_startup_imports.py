@@ -78,6 +78,8 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     assert _heavy(names, [*NEVER, "scipy.interpolate", "scipy.spatial", "scipy.optimize", "scipy.sparse"]) == []
     assert "scipy.linalg" not in names and "scipy.linalg._flapack" in names  # LAPACK without scipy.linalg
     assert [m for m in OTHER_KINDS if m in names] == []  # the registry loaded this kind's runner only
+    ik = {"robocfg.kinematics.ik.lm", "robocfg.kinematics.ik.pink_qp", "robocfg.kinematics.ik.placo_qp"}
+    assert ik & names == {"robocfg.kinematics.ik.lm"}  # the IK backend it solves with, not the QP ones
 
 
 def test_lapack_routines_are_scipys_own_functions(tmp_path) -> None:

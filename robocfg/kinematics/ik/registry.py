@@ -22,11 +22,12 @@ if TYPE_CHECKING:
 BackendFactory = Callable[["KinematicModel"], "IKSolver"]
 
 _REGISTRY: dict[str, BackendFactory] = {}
-_BUILTIN_MODULES = (
-    "robocfg.kinematics.ik.lm",
-    "robocfg.kinematics.ik.pink_qp",
-    "robocfg.kinematics.ik.placo_qp",
-)
+_BUILTIN = {  # backend name -> the module that registers it
+    "lm": "robocfg.kinematics.ik.lm",
+    "pink": "robocfg.kinematics.ik.pink_qp",
+    "placo": "robocfg.kinematics.ik.placo_qp",
+}
+_BUILTIN_MODULES = tuple(_BUILTIN.values())
 _builtins_loaded = False
 
 
@@ -57,8 +58,12 @@ def known_backends() -> list[str]:
 
 
 def get_backend(name: str) -> BackendFactory:
-    """The factory registered as ``name``; NotFound lists the known names."""
-    _load_builtins()
+    """The factory registered as ``name``; NotFound lists the known names. A built-in backend
+    loads its own module only (a process that solves with ``lm`` imports neither QP module)."""
+    if name in _BUILTIN and name not in _REGISTRY:
+        importlib.import_module(_BUILTIN[name])
+    if name not in _REGISTRY:
+        _load_builtins()
     try:
         return _REGISTRY[name]
     except KeyError:
