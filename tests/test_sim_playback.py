@@ -7,7 +7,7 @@ import pybullet as p
 import pytest
 from _sim_helpers import PANDA, make_task
 
-from robocfg.errors import RunInterrupted
+from robocfg.errors import RobocfgError, RunInterrupted
 from robocfg.sim.world import World
 
 
@@ -96,3 +96,75 @@ def test_play_rejects_mismatched_rows(tmp_path):
             w.play(arm, q, qd[:4])
         with pytest.raises(ValueError, match="shape"):
             w.play(arm, q[:, :6], qd[:, :6])
+
+
+def _run_bare(tmp_path, how: str, *, stop_at: int | None = None, max_joint_velocity: float = 100.0,
+              rate: float | None = None, idle_steps: int = 0):
+    """Play the rows with nothing else running per step (no hook, no ``after``; the gripper busy
+    only with ``rate``), either with ``play``/``step(n)`` or row by row; returns the state, the
+    steps at which the divergence check ran, where a stop or a divergence ended it, the drives."""
+    task = make_task(tmp_path, PANDA)
+    with World(task, max_joint_velocity=max_joint_velocity) as w:
+        arm = w.robot.arm()
+        q, qd = _rows(arm)
+        checked: list[int] = []
+        check = w._check
+        w._check = lambda: (checked.append(w.steps), check())[1]  # type: ignore[method-assign]
+        if stop_at is not None:
+            w.should_stop = lambda: w.steps >= stop_at
+        if rate is not None:
+            arm.gripper.rate = rate
+            arm.gripper.close()  # rate-limited: the target moves in update() after every step
+        ended = None
+        try:
+            w.step(3)  # the play starts off the check grid
+            if how == "fast":
+                w.play(arm, q, qd)
+                w.step(idle_steps)
+            else:
+                for row, v in zip(q.tolist(), qd.tolist(), strict=True):
+                    arm.command(row, v)
+                    w.step()
+                for _ in range(idle_steps):
+                    w.step()
+        except RobocfgError as exc:
+            ended = (type(exc).__name__, w.steps, w.t, str(exc))
+        drives = w.robot.drives
+        return (_state(w), w.steps, w.t, checked, ended,
+                [(drives[j].target, drives[j].target_velocity) for j in arm.joints])
+
+
+@pytest.mark.parametrize("case", [
+    {},  # the bare loop: a move, then idle steps
+    {"idle_steps": 37},
+    {"stop_at": 50},  # a stop request answered at the same check
+    {"max_joint_velocity": 0.05},  # the divergence check raises at the same step
+    {"rate": 2.0, "idle_steps": 30},  # a busy gripper: updated after every step
+])
+def test_bare_loops_are_bit_for_bit_the_per_step_loop(tmp_path, case):
+    fast, slow = _run_bare(tmp_path, "fast", **case), _run_bare(tmp_path, "slow", **case)
+    assert fast == slow
+    state, steps, t, checked, ended, _ = fast
+    assert checked and all(s % 5 == 0 for s in checked)  # every 20 ms of simulated time at 240 Hz
+    if "stop_at" in case:
+        assert ended is not None and ended[:2] == ("RunInterrupted", 50)
+    elif "max_joint_velocity" in case:
+        assert ended is not None and ended[0] == "PhysicsDiverged" and ended[1] == checked[-1]
+    else:
+        assert ended is None and steps == 3 + 120 + case.get("idle_steps", 0) and t == steps / 240
+    if "rate" in case:  # the closing fingers moved: the updates were not skipped
+        assert state[7][0] < _state_at_home(tmp_path)[7][0] - 1e-3
+
+
+def test_idle_world_skips_only_no_op_gripper_updates(tmp_path):
+    """``World.idle``: false while a step hook is installed or a gripper's target still moves."""
+    with World(make_task(tmp_path, PANDA)) as w:
+        g = w.robot.arm().gripper
+        assert w.idle() and not g.busy()
+        g.rate = 1.0
+        g.close()
+        assert g.busy() and not w.idle()
+        w.step(250)  # over 1 s at 1/s: the target has arrived
+        assert not g.busy() and w.idle()
+        w.step_hooks.append(lambda: None)
+        assert not w.idle()

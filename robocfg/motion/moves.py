@@ -255,10 +255,13 @@ class ArmMover:
         self.settle(seconds)
 
     def step(self, n: int) -> None:
+        """``n`` physics steps, ``on_step`` after each (none: the world's own loop, bare while idle)."""
+        if self.on_step is None:
+            self.world.step(n)
+            return
         for _ in range(n):
             self.world.step()
-            if self.on_step is not None:
-                self.on_step()
+            self.on_step()
 
     def settle(self, seconds: float) -> None:
         self.step(round(seconds / self.world.dt))

@@ -86,7 +86,8 @@ class _Episode:
         self.log = log or (lambda _msg: None)
         self.rng = np.random.default_rng([setup.seed, 7])
         self.mover = ArmMover(self.world, self.arm, ctx.model, ctx.limits, self.params.position_tolerance,
-                              self.params.orientation_tolerance, self.params.phase_timeout, self._on_step)
+                              self.params.orientation_tolerance, self.params.phase_timeout,
+                              self._on_step if recorder is not None else None)
         self.obj = self.world.add_body(setup.body)
         self.world.set_dynamics(self.obj, rolling_friction=ROLLING_FRICTION, spinning_friction=ROLLING_FRICTION)
         self.attempts: list[AttemptRecord] = []

@@ -53,8 +53,11 @@ class _StateMachine(GraspChoice):
         self.planned = tools.planned
         if self.planned is not None:  # a failed episode may have left its object attached
             self.planned.detach(setup.body.name)
+        # A per-step callback only where something samples the steps (a video recorder, or a
+        # subclass's own ``_on_step``): without one the world steps in its bare loop.
+        sampled = recorder is not None or type(self)._on_step is not _StateMachine._on_step
         self.mover = ArmMover(world, arm, tools.model, tools.limits, params.position_tolerance,
-                              params.orientation_tolerance, on_step=self._on_step, phase="setup")
+                              params.orientation_tolerance, on_step=self._on_step if sampled else None, phase="setup")
         if params.grip_force is not None:
             self.gripper.set_force(params.grip_force)
         self.shape = tools.shape or object_shape(setup.body, world.task.path.parent)

@@ -38,7 +38,7 @@ from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
 from robocfg.sim.bodies import ShapeCache, spawn_body, spawn_ground, spawn_pedestal, spawn_table
-from robocfg.sim.gripper import make_gripper
+from robocfg.sim.gripper import Gripper, make_gripper
 from robocfg.sim.loading import filter_gripper_linkage, load_robot_urdf
 from robocfg.sim.mimic import MimicGears
 from robocfg.sim.queries import SceneQueries
@@ -82,7 +82,7 @@ class World(SceneQueries):
         self.robots: list[RobotHandle] = []
         self.mimic: dict[int, MimicGears] = {}
         self._dynamic: list[int] = []
-        self._grippers: list = []
+        self._grippers: list[Gripper] = []
         if self.gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise RobocfgError("--gui needs a display (DISPLAY is not set); run headless without --gui, "
                                "or under xvfb-run")
@@ -251,15 +251,36 @@ class World(SceneQueries):
         return quat_to_matrix(self.body_pose(name_or_id)[1])
 
     # ---- stepping -----------------------------------------------------------------------
+    @property
+    def check_every(self) -> int:
+        """Physics steps between two divergence checks (``check_interval`` s of simulated time)."""
+        return self._check_every
+
+    @property
+    def grippers(self) -> list[Gripper]:
+        """Every arm's gripper, in the order ``step`` updates them."""
+        return self._grippers
+
+    def idle(self) -> bool:
+        """True while nothing but physics needs the next steps one by one: no step hooks and no
+        gripper with work in ``update()`` (:meth:`~robocfg.sim.gripper.base.Gripper.busy`)."""
+        return not self.step_hooks and not any(g.busy() for g in self._grippers)
+
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` physics steps of ``dt``; grippers update after each; divergence raises."""
+        """Advance ``n`` physics steps of ``dt``; grippers update after each; divergence raises.
+        While :meth:`idle`, the steps run in :func:`robocfg.sim.playback.advance_idle`'s bare loop
+        (the same steps and checks without the per-step bookkeeping)."""
+        if n > 1 and self.idle():
+            from robocfg.sim.playback import advance_idle
+
+            advance_idle(self, n)
+            return
         for _ in range(n):
             self._advance()
 
     def _advance(self) -> None:
         """One physics step and its bookkeeping (clock, grippers, periodic checks, step hooks):
-        the body of :meth:`step`; :func:`robocfg.sim.playback.play_rows` inlines it (keep the two
-        in step)."""
+        the body of :meth:`step`; :mod:`robocfg.sim.playback` inlines it (keep them in step)."""
         clock = time.perf_counter
         t0 = clock()
         p.stepSimulation(physicsClientId=self.client)
@@ -269,11 +290,16 @@ class World(SceneQueries):
         for g in self._grippers:
             g.update()
         if steps % self._check_every == 0:
-            self._check()
-            if self.should_stop is not None and self.should_stop():
-                raise RunInterrupted("simulation", "SIGINT/SIGTERM")
+            self.periodic_check()
         for hook in self.step_hooks:
             hook()
+
+    def periodic_check(self) -> None:
+        """What ``step`` does every ``check_every`` steps: the divergence check
+        (``PhysicsDiverged``), then the stop request (``RunInterrupted``)."""
+        self._check()
+        if self.should_stop is not None and self.should_stop():
+            raise RunInterrupted("simulation", "SIGINT/SIGTERM")
 
     def play(self, arm: ArmHandle, q: np.ndarray, qd: np.ndarray, after: Callable[[], None] | None = None) -> None:
         """Play a sampled joint trajectory on ``arm``: before physics step k, position targets

@@ -39,6 +39,13 @@ class Gripper(ABC):
     def update(self) -> None:  # noqa: B027 (no-op by design: most grippers have nothing to advance)
         """Advance rate-limited targets, attach/detach... Called by the World after each step."""
 
+    def busy(self) -> bool:
+        """Whether ``update()`` may do something after the next physics step. While no gripper is
+        busy (and no step hook is installed) the World steps without calling ``update()``
+        (:mod:`robocfg.sim.playback`): only a command, never a physics step, makes a gripper busy.
+        A subclass that overrides ``update`` is busy unless it overrides this too."""
+        return type(self).update is not Gripper.update
+
     @abstractmethod
     def open(self) -> None:
         """Start opening (non-blocking)."""

@@ -101,6 +101,10 @@ class ParallelGripper(Gripper):
             self.robot.mimic.sync()
         self._send()
 
+    def busy(self) -> bool:
+        """True while a rate-limited target is still moving towards the commanded opening."""
+        return bool(self._cmd != self._goal)
+
     def update(self) -> None:
         if self._cmd == self._goal:
             return

@@ -72,6 +72,10 @@ class SuctionGripper(Gripper):
     def is_grasping(self, body: int | str) -> bool:
         return self.attached is not None and self.attached == self._body_id(body)
 
+    def busy(self) -> bool:
+        """True while suction is on: each step looks for a body to hold, or checks the one held."""
+        return self.active
+
     def update(self) -> None:
         if not self.active:
             return
