@@ -58,19 +58,20 @@ class GraspChoice:
         must wind round a joint limit to carry.)"""
         first: list[Grasp] | None = None
 
-        def travel(g: Grasp) -> tuple[bool, float]:
-            """(does a straight approach or lower line break, joint travel in rad); inf: unreachable."""
+        def reach(g: Grasp) -> tuple[float, list[tuple[np.ndarray, np.ndarray]]]:
+            """(joint travel in rad, the straight lines down to check: (start q, goal EE pose));
+            inf travel: unreachable."""
             shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
             T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
             T_grasp = ee_pose_from_grasp(g, self.cfg)
-            cost, q, broken = 0.0, q0, False
+            cost, q, lines = 0.0, q0, []
             for T, T_down in ((T_pre, T_grasp), (shifted(T_pre, shift), shifted(T_grasp, shift))):
                 res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
                 if not res.converged:
-                    return True, math.inf
+                    return math.inf, []
                 cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
-                broken = broken or not self._line_continuous(q, T_down)
-            return broken, cost
+                lines.append((q, T_down))
+            return cost, lines
 
         for group in self._iter_grasp_groups(lying):  # searched one at a time: usually the first will do
             if first is None:
@@ -78,9 +79,17 @@ class GraspChoice:
                 R_now = self.arm.ee_pose()[:3, :3]
                 q0 = self.arm.joint_positions()
             cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
-            costs = [travel(g) for g in cands]
-            if min(c for _, c in costs) < math.inf:
-                return cands[min(range(len(cands)), key=lambda i: costs[i])]
+            reached = [reach(g) for g in cands]
+            order = sorted((i for i, (cost, _) in enumerate(reached) if cost < math.inf), key=lambda i: (reached[i][0], i))
+            if not order:
+                continue
+            # The least travel among those whose lines are continuous (ties: the smaller wrist turn),
+            # else the least travel: the lines (the costly part, IK every 3 cm) are checked in order
+            # of travel, only until one candidate passes.
+            for i in order:
+                if all(self._line_continuous(q, T_down) for q, T_down in reached[i][1]):
+                    return cands[i]
+            return cands[order[0]]
         if first is None:
             raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
         return first[0]
