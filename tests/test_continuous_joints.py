@@ -55,6 +55,7 @@ def test_ik_answers_match_fk_and_continuous_joints_take_the_nearest_turn():
 def test_trajectory_turns_a_continuous_wrist_past_pi(tmp_path, capsys, monkeypatch):
     task = _task(tmp_path, "trajectory", {
         "waypoints": ["home", {"position": [0.45, 0.3, 0.35], "euler_deg": [180.0, 0.0, -60.0]}, "home"],
+        "orientation_frame": "ee_link",  # the angles of the fixture's own ee_link (its wrist turn past π)
         "limits": {"velocity_scale": 0.5, "acceleration_scale": 0.5, "acceleration": 10.0}})
     out = tmp_path / "r.json"
     code, _, err = run_main(["run", "trajectory", str(task), "--json", str(out), "-q"], capsys, monkeypatch)
@@ -70,7 +71,7 @@ def test_trajectory_turns_a_continuous_wrist_past_pi(tmp_path, capsys, monkeypat
 def test_follow_target_runs_on_continuous_joints(tmp_path, capsys, monkeypatch):
     task = _task(tmp_path, "follow_target", {
         "motion": {"type": "circle", "center": [0.5, 0.0, 0.4], "radius": 0.1, "period": 4.0, "plane": "yz"},
-        "target_euler_deg": [180.0, 0.0, 0.0], "duration": 3.0, "settle_time": 1.0})
+        "target_euler_deg": [180.0, 0.0, 0.0], "orientation_frame": "ee_link", "duration": 3.0, "settle_time": 1.0})
     out = tmp_path / "r.json"
     code, _, err = run_main(["run", "follow-target", str(task), "--json", str(out), "-q"], capsys, monkeypatch)
     assert code == 0, err

@@ -128,16 +128,19 @@ def test_a_scaled_motion_keeps_its_times_unless_the_joints_cannot_keep_up():
 
 
 def test_the_servo_brakes_as_the_joints_can_instead_of_trading_position():
-    """UR5e on the default circle: its home holds the 2F-85 a quarter turn about the tool axis from
-    the target, turned at the 2 rad/s cap. The servo stopped that turn within a few control periods
-    (20/s gain), the 10 rad/s² joint limits could not follow and the QP gave up 36 mm of position
-    for ~0.3 s after settling; braking at max_angular_acceleration keeps the position."""
+    """UR5e on the default circle with the angles read on tool0 (``orientation_frame: ee_link``, the
+    meaning before the tool frame) and the whole orientation tracked: its home holds the 2F-85 a
+    quarter turn about the tool axis from that target, turned at the 2 rad/s cap. The servo stopped
+    that turn within a few control periods (20/s gain), the 10 rad/s² joint limits could not follow
+    and the QP gave up 36 mm of position for ~0.3 s after settling; braking at
+    max_angular_acceleration keeps the position."""
     from robocfg.checks import load_task
     from robocfg.config import catalog
     from robocfg.runners.follow_target import run_follow_target
 
     task = load_task(catalog.find("tasks", "follow_target"), robot_override="ur5e_robotiq_2f85",
-                     overrides={"follow_target.duration": 2.0})
+                     overrides={"follow_target.duration": 2.0, "follow_target.orientation_frame": "ee_link",
+                                "follow_target.tool_roll": "tracked"})
     res = run_follow_target(task)
     assert res.tool_roll == "tracked" and res.samples[0][2] > 80.0  # it did start a quarter turn away
     assert res.reached and res.position_error_mm.max < 2.0 and res.orientation_error_deg.max < 1.0
@@ -157,3 +160,44 @@ def test_the_irb7600_circle_gets_the_largest_scale_ik_reaches():
     report = run_follow_target(task)
     assert report.reached, report.unreachable_reason
     assert report.position_error_mm.rms < 5.0
+
+
+def test_the_default_target_is_the_same_tool_pose_on_a_ur():
+    """The default target_euler_deg [180, 0, 0] is read in the tool frame (``orientation_frame:
+    tool``): on the UR5e, whose 2F-85 closes along tool0 x, that is the pose its home already holds
+    (on tool0 it was a quarter turn away, which the arm turned in its first second)."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.runners.follow_target import run_follow_target
+
+    task = load_task(catalog.find("tasks", "follow_target"), robot_override="ur5e_robotiq_2f85",
+                     overrides={"follow_target.duration": 2.0})
+    res = run_follow_target(task)
+    assert res.tool_roll == "symmetric" and res.samples[0][2] < 5.0  # not a quarter turn away
+    assert res.reached and res.orientation_error_deg.max < 0.5
+
+
+def test_a_parallel_gripper_is_not_turned_half_a_turn(tmp_path):
+    """A Panda whose home holds the hand half a turn about the tool axis from the target: its two
+    jaws look the same either way (``tool_roll: auto`` = symmetric for a parallel gripper), so the
+    half-turned target is tracked from the start; tracked as written, the wrist turns half a turn
+    at 2 rad/s and the run is not reached (the drafted UR10 + 2F-85's failure)."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.runners.follow_target import run_follow_target
+
+    text = catalog.find("robots", "panda").read_text()
+    assert "home: [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]" in text
+    robot = tmp_path / "panda_turned.yaml"
+    robot.write_text(text.replace("home: [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]",
+                                  "home: [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, -2.3566]"))
+
+    def run(roll: str):
+        task = load_task(catalog.find("tasks", "follow_target"), robot_override=str(robot),
+                         overrides={"follow_target.duration": 2.0, "follow_target.tool_roll": roll})
+        return run_follow_target(task)
+
+    sym, tracked = run("auto"), run("tracked")
+    assert sym.tool_roll == "symmetric" and any("turned half a turn about the tool axis" in w for w in sym.warnings)
+    assert sym.samples[0][2] < 1.0 and sym.reached and sym.orientation_error_deg.max < 0.5
+    assert tracked.samples[0][2] > 170.0 and not tracked.reached

@@ -9,8 +9,11 @@ from robocfg.config.types import AXIS_INDEX
 from robocfg.kinematics.frames import (
     Grasp,
     ee_pose_from_grasp,
+    ee_rotation,
     grasp_rotation,
+    half_turn,
     tcp_from_ee,
+    tool_R_ee,
     top_down_grasps,
 )
 
@@ -51,3 +54,40 @@ def test_top_down_grasp_closes_across_narrow_side():
         assert np.isclose(abs(g.closing() @ [-np.sin(yaw), np.cos(yaw), 0]), 1.0)
         assert np.isclose(g.width, 0.03)
     assert np.allclose(grasps[0].closing(), -grasps[1].closing())
+
+
+def _robot_arms():
+    return [(name, arm) for name, path in catalog.available("robots").items() for arm in load_robot(path).config.arms]
+
+
+def test_a_tool_orientation_is_one_tool_pose_on_every_robot():
+    """``orientation_frame: tool``: tool z = approach (grasp x), tool y = closing (grasp y), whatever
+    the robot's ee_link frame, for every built-in arm and a Z1-like arm approaching along ee x."""
+    from robocfg.geometry import euler_deg_to_quat_xyzw, quat_to_matrix
+
+    arms = [arm for _, arm in _robot_arms()]
+    panda = load_robot(catalog.find("robots", "panda")).config.arms[0]
+    z1_like = panda.model_copy(update={"ee_axis": "x", "R_ee_graspnet": [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]})
+    rng = np.random.default_rng(0)
+    rotations = [quat_to_matrix(euler_deg_to_quat_xyzw([180.0, 0.0, 0.0]))]
+    rotations += [quat_to_matrix(euler_deg_to_quat_xyzw(list(rng.uniform(-180, 180, 3)))) for _ in range(5)]
+    for arm in [*arms, z1_like]:
+        for R_tool in rotations:
+            R_ee = ee_rotation(R_tool, arm, "tool")
+            R_grasp = R_ee @ np.asarray(arm.R_ee_graspnet).T
+            assert np.allclose(R_grasp[:, 0], R_tool[:, 2], atol=1e-12)  # approach = tool z
+            assert np.allclose(R_grasp[:, 1], R_tool[:, 1], atol=1e-12)  # closing = tool y
+            assert np.allclose(R_ee[:, AXIS_INDEX[arm.ee_axis]], R_tool[:, 2], atol=1e-12)
+            assert np.array_equal(ee_rotation(R_tool, arm, "ee_link"), R_tool)
+    down = rotations[0]
+    assert np.array_equal(ee_rotation(down, panda, "tool"), down)  # the Panda's hand frame is its tool frame
+    assert np.array_equal(tool_R_ee(panda), np.eye(3))
+    assert ee_rotation(down, z1_like, "tool")[2, 0] == pytest.approx(-1.0)  # Z1: approach (ee x) straight down
+    assert abs(ee_rotation(down, z1_like, "ee_link")[2, 0]) < 1e-12  # the same angles on the link: horizontal
+
+
+def test_half_turn_turns_about_the_tool_axis(panda_arm):
+    R = grasp_rotation([0, 0, -1], [0.3, 1.0, 0.0]) @ np.asarray(panda_arm.R_ee_graspnet)
+    H = half_turn(R, panda_arm)
+    assert np.allclose(H[:, 2], R[:, 2]) and np.allclose(H[:, :2], -R[:, :2])
+    assert np.isclose(np.linalg.det(H), 1.0)

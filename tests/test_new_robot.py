@@ -99,6 +99,11 @@ def test_composed_robot_draft_reproduces_the_shipped_tcp(tmp_path, capsys, monke
     q = dict(zip(got.joints, got.home, strict=True))
     tool_z = (draft.urdf.link_pose(got.ee_link, q))[:3, "xyz".index(got.ee_axis)]
     assert tool_z[2] < -0.999  # approach axis straight down
+    # fingers closing along world -y: the tool frame of the default tasks' [180, 0, 0] (follow-target starts there)
+    R_grasp = draft.urdf.link_pose(got.ee_link, q)[:3, :3] @ np.asarray(got.R_ee_graspnet).T
+    assert R_grasp[1, 1] < -0.999
+    # no arm link under the plane the robot stands on (the drafted UR10 got an elbow-down home 0.21 m into the floor)
+    assert min(draft.urdf.link_pose(link, q)[2, 3] for link in ("upper_arm_link", "forearm_link", "wrist_1_link")) > 0.0
     assert all(n in draft.config.physics.link_masses for n in ("left_inner_finger_pad", "robotiq_2f_85_base_link", "tool0"))
 
 

@@ -52,6 +52,8 @@ class TrajectoryParams(Frozen):
     gridpoints: Annotated[int, Field(ge=10, le=5000)] | None = Field(
         None, description="toppra grid size (default: 100, or 20 per segment for long paths)."
     )
+    orientation_frame: Literal["tool", "ee_link"] = Field(
+        "tool", description="Frame of the Cartesian waypoints' orientations. " "tool (default): orientations are the tool frame's (z = approach, y = fingers' closing axis, x = y × z, defined through the robot's R_ee_graspnet), so one orientation is one physical tool pose on every robot ([180, 0, 0]: tool pointing down). ee_link: the end-effector link's own frame, as written for one robot (the meaning before this option existed; the same for robots whose R_ee_graspnet is the Panda's).")
     placement: Literal["world", "auto"] = Field("world", description="world: Cartesian points are world coordinates (m), used as written. auto: world coordinates written for the robot the file names; a robot that cannot reach them (--robot) gets them moved with its arm: scaled about its arm base by the ratio of the two arms' reaches towards the points (see docs/task-yaml.md).")
 
 
@@ -115,16 +117,22 @@ class FollowTargetParams(Frozen):
     """``run follow-target``: the TCP follows a moving target, avoiding obstacles (a QP per control step)."""
 
     motion: Motion = Field(default_factory=Motion)
-    target_euler_deg: Vec3 = Field(default_factory=lambda: [180.0, 0.0, 0.0], description="Fixed TCP orientation (deg).")
+    target_euler_deg: Vec3 = Field(default_factory=lambda: [180.0, 0.0, 0.0],
+                                   description="Target orientation (deg, in orientation_frame; [180, 0, 0]: tool pointing down).")
+    orientation_frame: Literal["tool", "ee_link"] = Field(
+        "tool", description="Frame of target_euler_deg. " "tool (default): orientations are the tool frame's (z = approach, y = fingers' closing axis, x = y × z, defined through the robot's R_ee_graspnet), so one orientation is one physical tool pose on every robot ([180, 0, 0]: tool pointing down). ee_link: the end-effector link's own frame, as written for one robot (the meaning before this option existed; the same for robots whose R_ee_graspnet is the Panda's).")
     orientation: Literal["fixed", "following"] = Field(
         "fixed", description="fixed: target_euler_deg throughout; following: also turns about the motion plane's normal "
                              "by follow_angle_deg·sin(phase) (phase: 2π·t/period).")
     follow_angle_deg: FiniteFloat = Field(30.0, description="Amplitude of the 'following' orientation swing (deg).")
-    tool_roll: Literal["auto", "tracked", "free"] = Field(
+    tool_roll: Literal["auto", "tracked", "symmetric", "free"] = Field(
         "auto", description="The TCP's turn about the tool axis (ee_axis). tracked: the whole target orientation is "
-                            "followed and measured. free: the tool is symmetric about its axis, so only where it points "
-                            "is followed and measured (orientation error = angle between the tool axes). auto: free for "
-                            "a suction gripper, tracked otherwise.")
+                            "followed and measured. symmetric: the tool looks the same turned half a turn about its "
+                            "axis (two jaws closing symmetrically), so of the target and the target turned half a turn, "
+                            "the one nearer the arm's home orientation is tracked. free: the tool is symmetric about "
+                            "its axis, so only where it points is followed and measured (orientation error = angle "
+                            "between the tool axes). auto: free for a suction gripper, symmetric for a parallel "
+                            "gripper, tracked otherwise (a one-jaw gripper, no gripper).")
     with_obstacle: bool = False
     obstacles: list[FollowObstacle] = Field(default_factory=list, description="Spawned only with with_obstacle (or --with-obstacle).")
     duration: PositiveFloat = 8.0

@@ -4,6 +4,13 @@ GraspNet grasp frame: origin at the grasp centre between the fingers, x = approa
 (gripper → object), y = finger closing direction, z = x × y. ``R_ee_graspnet`` is constant with
 ``world_R_ee = world_R_grasp · R_ee_graspnet``; the EE origin sits ``tcp_offset`` behind the TCP
 along the EE's ``ee_axis``. All poses are 4x4 homogeneous matrices in the world frame (m).
+
+Tool frame (what task orientations mean, ``orientation_frame: tool``): origin at the TCP, z = the
+approach direction (grasp x), y = the closing direction (grasp y), x = y × z (= −grasp z). It is
+defined through ``R_ee_graspnet``, so one task orientation is one physical tool pose on every
+robot: ``[180, 0, 0]`` points the tool straight down with the fingers closing along world ∓y, on
+a Panda (whose hand frame *is* its tool frame), a UR with tool0 turned a quarter turn from that,
+or a Unitree Z1 whose approach axis is its ee_link's x.
 """
 
 from __future__ import annotations
@@ -42,6 +49,31 @@ def grasp_rotation(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
     (x0, x1, x2), (y0, y1, y2) = x.tolist(), y.tolist()
     z = [x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0]  # x × y, np.cross's arithmetic without its overhead
     return np.column_stack([x, y, z])
+
+
+# grasp_R_tool: the tool frame's axes in grasp coordinates (x = −grasp z, y = grasp y, z = grasp x)
+GRASP_R_TOOL = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
+
+
+def tool_R_ee(arm: ArmConfig) -> np.ndarray:
+    """The rotation of ``ee_link`` in the tool frame (3x3): ``world_R_ee = world_R_tool · tool_R_ee``.
+    The identity for an arm whose ``R_ee_graspnet`` is the Panda's (approach = ee z, closing = ee y)."""
+    return GRASP_R_TOOL.T @ np.asarray(arm.R_ee_graspnet, float)
+
+
+def ee_rotation(R: np.ndarray, arm: ArmConfig, frame: str) -> np.ndarray:
+    """world_R_ee for a task orientation ``R`` (3x3, world) written in ``frame``: ``tool`` (the tool
+    frame, converted through the robot's ``R_ee_graspnet``) or ``ee_link`` (already the ee_link's)."""
+    R = np.asarray(R, float)
+    T = tool_R_ee(arm)
+    return R @ T if frame == "tool" and not np.array_equal(T, np.eye(3)) else R.copy()
+
+
+def half_turn(R_ee: np.ndarray, arm: ArmConfig) -> np.ndarray:
+    """``R_ee`` (world_R_ee) turned half a turn about the tool's axis (the arm's ``ee_axis``)."""
+    flip = -np.ones(3)
+    flip[AXIS_INDEX[arm.ee_axis]] = 1.0
+    return np.asarray(R_ee, float) * flip  # R · diag(flip): the two other columns reversed
 
 
 def grasp_side_shift(arm: ArmConfig, width: float) -> float:

@@ -31,6 +31,7 @@ import numpy as np
 from robocfg.checks.robot import CheckedRobot, load_robot
 from robocfg.checks.task import CheckedTask
 from robocfg.geometry import pose_matrix
+from robocfg.kinematics.frames import tool_R_ee
 from robocfg.motion.placement import farthest_reachable
 
 FK_SAMPLES = 400  # random configurations bounding how far the TCP can get from the arm base
@@ -57,10 +58,14 @@ class PointMap:
         return float(self.scale * x)
 
 
-def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: str) -> PointMap | None:
-    """The map for ``poses`` (4x4 world_T_tcp targets written for the task's robot), or None when
-    the running robot's ``arm`` reaches every one, the file names the running robot itself, or no
-    reach can be measured (the run then reports the unreachable points itself)."""
+def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: str,
+             frame: str = "ee_link") -> PointMap | None:
+    """The map for ``poses`` (4x4 world_T_tcp targets of the running robot's ``arm``, its TCP frame
+    having ee_link's rotation), or None when that arm reaches every one, the file names the running
+    robot itself, or no reach can be measured (the run then reports the unreachable points itself).
+    ``frame``: what the task's orientations were written in; with ``tool`` the task's robot is
+    measured with the same *tool* orientation (converted through each robot's ``R_ee_graspnet``),
+    with ``ee_link`` with the same ee_link rotation."""
     ours_robot = task.robots[0]
     ours = _model(task, ours_robot, arm)
     if all(_reaches(ours, ours_robot, arm, T) for T in poses):
@@ -77,7 +82,11 @@ def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: 
         return None
     direction /= np.linalg.norm(direction)
     R = poses[0][:3, :3]
-    r_theirs = _reach(theirs, theirs_robot, None, b_theirs, direction, R)
+    R_theirs = R
+    to_ours, to_theirs = tool_R_ee(ours_robot.config.arm(arm)), tool_R_ee(theirs_robot.config.arm(None))
+    if frame == "tool" and not np.array_equal(to_ours, to_theirs):  # the same tool orientation on the task's robot
+        R_theirs = R @ to_ours.T @ to_theirs
+    r_theirs = _reach(theirs, theirs_robot, None, b_theirs, direction, R_theirs)
     r_ours = _reach(ours, ours_robot, arm, b_ours, direction, R)
     measured = r_theirs > 0.0 and r_ours > 0.0
     ratio = r_ours / r_theirs if measured else 1.0

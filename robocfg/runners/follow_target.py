@@ -108,17 +108,40 @@ def placed_params(task: CheckedTask, arm: str | None, params: FollowTargetParams
     """``params`` with the motion (centre, radius, waypoints) and the obstacles (positions,
     sizes, motions) moved to the running robot's arm for ``placement: auto`` when it cannot reach
     the target as written (``robocfg.motion.relative``); the line saying so."""
+    placed, note, _R = _placed(task, arm, params)
+    return placed, note
+
+
+def target_rotation(task: CheckedTask, arm: str | None, params: FollowTargetParams) -> tuple[np.ndarray, str]:
+    """The target's rotation for the running arm's TCP frame (world_R_ee, 3×3): ``target_euler_deg``
+    read in ``orientation_frame`` and, for ``tool_roll`` symmetric, turned half a turn about the tool
+    axis when that is nearer the arm's home orientation (``robocfg.motion.orientation``); the line
+    saying so (empty when not turned)."""
+    from robocfg.motion.orientation import ee_target_rotation, home_rotation, resolved_tool_roll
+
+    arm_cfg = task.robots[0].config.arm(arm)
+    roll = resolved_tool_roll(params.tool_roll, arm_cfg)
+    start = home_rotation(task, arm_cfg.name) if roll == "symmetric" else None
+    R, turned = ee_target_rotation(quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)), arm_cfg,
+                                   params.orientation_frame, roll, start)
+    note = (f"tool_roll symmetric: the target orientation turned half a turn about the tool axis, nearer "
+            f"{task.robots[0].config.name}'s home orientation (the gripper's two jaws look the same)") if turned else ""
+    return R, note
+
+
+def _placed(task: CheckedTask, arm: str | None, params: FollowTargetParams) -> tuple[FollowTargetParams, str, np.ndarray]:
+    """(``placed_params``'s answer, the target rotation of ``target_rotation``)."""
     from robocfg.motion.relative import PointMap, auto_map
     from robocfg.motion.targets import TargetMotion
 
+    R, turned = target_rotation(task, arm, params)
     if params.placement != "auto":
-        return params, ""
-    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
-                          params.orientation, math.radians(params.follow_angle_deg))
+        return params, turned, R
+    target = TargetMotion(params.motion, R, params.orientation, math.radians(params.follow_angle_deg))
     poses = [target.pose(float(t)) for t in np.linspace(0.0, params.duration, POSE_SAMPLES)]
-    m = auto_map(task, arm, poses, "the target's motion and obstacles")
+    m = auto_map(task, arm, poses, "the target's motion and obstacles", params.orientation_frame)
     if m is None:
-        return params, ""
+        return params, turned, R
 
     def motion(mo: Motion, pm: PointMap) -> Motion:
         return mo.model_copy(update={"center": pm.point(mo.center), "radius": pm.length(mo.radius),
@@ -129,18 +152,19 @@ def placed_params(task: CheckedTask, arm: str | None, params: FollowTargetParams
                  for o in params.obstacles]
     placed = params.model_copy(update={"motion": motion(params.motion, m), "obstacles": obstacles,
                                        "max_speed": m.length(params.max_speed)})
-    return _paced(task, arm, placed, m.scale, m.note)
+    paced, note = _paced(task, arm, placed, m.scale, m.note, R)
+    return paced, "; ".join(n for n in (turned, note) if n), R
 
 
-def _paced(task: CheckedTask, arm: str | None, params: FollowTargetParams, k: float, note: str) -> tuple[FollowTargetParams, str]:
+def _paced(task: CheckedTask, arm: str | None, params: FollowTargetParams, k: float, note: str,
+           R: np.ndarray) -> tuple[FollowTargetParams, str]:
     """Times for a motion scaled ×k: kept (the same angular speed, TCP speeds and the speed cap ×k)
     while the arm's joints need at most ``JOINT_SPEED_SHARE`` of their velocity limits for it
     (``robocfg.motion.target_speed``); else stretched until they do. The note says which."""
     from robocfg.motion.target_speed import arm_joint_speed
     from robocfg.motion.targets import TargetMotion
 
-    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
-                          params.orientation, math.radians(params.follow_angle_deg))
+    target = TargetMotion(params.motion, R, params.orientation, math.radians(params.follow_angle_deg))
     js = arm_joint_speed(task, arm, target, params.duration, params.velocity_scale)
     missed = f", {js.unreached} of {js.samples} sampled poses out of IK reach" if js.unreached else ""
     if js.share <= JOINT_SPEED_SHARE:
@@ -164,9 +188,8 @@ def _placed_target(task: CheckedTask, arm: str | None, params: FollowTargetParam
 
     params = params or task.config.follow_target  # type: ignore[union-attr]
     assert params is not None
-    params, note = placed_params(task, arm, params)
-    target = TargetMotion(params.motion, quat_to_matrix(euler_deg_to_quat_xyzw(params.target_euler_deg)),
-                          params.orientation, math.radians(params.follow_angle_deg))
+    params, note, R = _placed(task, arm, params)
+    target = TargetMotion(params.motion, R, params.orientation, math.radians(params.follow_angle_deg))
     return params, note, target
 
 

@@ -15,7 +15,6 @@ import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import FollowObstacle, FollowTargetParams
-from robocfg.config.robot import ArmConfig, SuctionGripperConfig
 from robocfg.config.scene import Body
 from robocfg.config.types import AXIS_INDEX
 from robocfg.engine.options import RunOptions
@@ -41,7 +40,10 @@ class FollowLoop:
         self.task, self.world, self.params, self.target = task, world, params, target
         world.should_stop = options.should_stop
         self.arm = world.robot.arm(options.arm)
-        self.free_roll = free_roll(params, self.arm.config)
+        from robocfg.motion.orientation import resolved_tool_roll
+
+        roll = resolved_tool_roll(params.tool_roll, self.arm.config)
+        self.free_roll = roll == "free"
         self.n_sub = max(1, round(1.0 / (params.control_rate * world.dt)))
         self.ctrl_dt = self.n_sub * world.dt
         obstacles = _obstacles(params, use_obstacle, self.arm.tcp_pose()[:3, 3], target.position(0.0))
@@ -50,7 +52,7 @@ class FollowLoop:
             orientation=params.orientation, with_obstacle=use_obstacle,
             obstacles=[o.name for o in task.config.scene.obstacles] + [o.name for o in obstacles],
             duration=params.duration, control_rate=1.0 / self.ctrl_dt, safety_margin=params.safety_margin,
-            settle_time=params.settle_time, tool_roll="free" if self.free_roll else "tracked")
+            settle_time=params.settle_time, tool_roll=roll)
         r.warnings = [p.format() for p in task.warnings] + list(world.warnings)
         if abs(1.0 / self.ctrl_dt - params.control_rate) > 0.01 * params.control_rate:
             r.warnings.append(f"control_rate {params.control_rate:g} Hz is not a divisor of the physics rate "
@@ -238,14 +240,6 @@ class FollowLoop:
         if self.failure is not None:
             raise RunFailed(self.failure.phase, self.failure.reason, report=r) from None
         return r
-
-
-def free_roll(params: FollowTargetParams, arm: ArmConfig) -> bool:
-    """Whether the TCP's roll about the tool axis goes untracked and unmeasured (``tool_roll``:
-    ``auto`` = a suction gripper, whose cup is symmetric about its axis)."""
-    if params.tool_roll == "auto":
-        return isinstance(arm.gripper, SuctionGripperConfig)
-    return params.tool_roll == "free"
 
 
 def drive_target(q_end: np.ndarray, dq: np.ndarray, ctrl_dt: float, n_sub: int) -> np.ndarray:

@@ -51,7 +51,9 @@ class FollowTargetResult(SingleRunReport):
     control_rate: float  # Hz (actual: physics rate / substeps)
     safety_margin: float  # m
     settle_time: float  # s
-    tool_roll: str = "tracked"  # "free": orientation error = angle between the tool axes (roll about it not counted)
+    # "free": orientation error = angle between the tool axes (roll about it not counted); "symmetric": the
+    # whole orientation is tracked, the target taken half-turned about the tool axis when nearer home
+    tool_roll: str = "tracked"
     success: bool = False
     position_error_mm: Stats | None = None  # after settling
     orientation_error_deg: Stats | None = None

@@ -122,10 +122,11 @@ def _placed_waypoints(task: CheckedTask, arm_name: str, params: TrajectoryParams
     from robocfg.motion.relative import auto_map
 
     waypoints = list(params.waypoints)
-    poses = [pose_matrix(w) for w in waypoints if isinstance(w, Pose)]
+    to_ee = _to_ee(task, arm_name, params)
+    poses = [to_ee(pose_matrix(w)) for w in waypoints if isinstance(w, Pose)]
     if params.placement != "auto" or not poses:
         return waypoints, ""
-    m = auto_map(task, arm_name, poses, "Cartesian waypoints")
+    m = auto_map(task, arm_name, poses, "Cartesian waypoints", params.orientation_frame)
     if m is None:
         return waypoints, ""
     return [w.model_copy(update={"position": m.point(w.position)}) if isinstance(w, Pose) else w for w in waypoints], m.note
@@ -143,7 +144,23 @@ def _ik_fn(task: CheckedTask, arm_name: str, params: TrajectoryParams):
     mount = task.config.robots[0]
     model = KinematicModel.from_robot(task.robots[0], arm_name, base_pose=pose_to_matrix(mount.position, mount.quaternion_xyzw()))
     bound_ik_by_iterations(model)  # same waypoints ⇒ same joint values, whatever the machine load
-    return lambda target, seed: model.ik(target, seed_q=seed, frame="tcp")
+    to_ee = _to_ee(task, arm_name, params)
+    return lambda target, seed: model.ik(to_ee(target), seed_q=seed, frame="tcp")
+
+
+def _to_ee(task: CheckedTask, arm_name: str, params: TrajectoryParams):
+    """world_T_tcp for a Cartesian waypoint's pose (4x4) whose orientation is written in the
+    task's ``orientation_frame`` (``robocfg.kinematics.frames.ee_rotation``)."""
+    from robocfg.kinematics.frames import ee_rotation
+
+    arm = task.robots[0].config.arm(arm_name)
+
+    def to_ee(T: np.ndarray) -> np.ndarray:
+        out = np.array(T, float)
+        out[:3, :3] = ee_rotation(out[:3, :3], arm, params.orientation_frame)
+        return out
+
+    return to_ee
 
 
 def run_trajectory(task: CheckedTask, gui: bool = False, record: Path | None = None,
