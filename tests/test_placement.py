@@ -114,3 +114,40 @@ def test_auto_placement_raises_the_work_surface_for_an_arm_that_cannot_reach_the
     assert e.success, (e.failed_phase, e.reason)
     assert abs(e.object_final[2] - (top + 0.025)) < 0.005  # the cube rests on the stand's top
     assert resolve_placement(load_task(catalog.find("tasks", "pick_place"))).stand is None
+
+
+def test_the_chain_bound_never_refuses_a_reachable_pose():
+    """ChainBound says "no" only where no joint values reach: every FK pose of random joint values
+    (within limits) on four arms passes, and a pose 1 cm past the stretched chain does not."""
+    from robocfg.checks import load_robot
+    from robocfg.kinematics.chain_bound import ChainBound
+    from robocfg.kinematics.model import KinematicModel
+
+    rng = np.random.default_rng(0)
+    for name in ("panda", "ur5e_robotiq_2f85", "kuka_kr210", "dual_arm_lift"):
+        model = KinematicModel.from_robot(load_robot(catalog.find("robots", name)))
+        bound = ChainBound.of(model)
+        assert bound.origin is not None and bound.length > 0.3
+        lo = np.where(np.isfinite(model.lower), model.lower, -np.pi)
+        hi = np.where(np.isfinite(model.upper), model.upper, np.pi)
+        for q in rng.uniform(lo, hi, (200, model.nq)):
+            assert bound.may_reach(model.fk(q, "ee"))
+        T = model.fk(np.asarray(model.home, float), "ee")
+        last = T[:3, 3] + T[:3, :3] @ bound.last_in_ee
+        away = (last - bound.origin) / np.linalg.norm(last - bound.origin)
+        T[:3, 3] += away * (bound.length + 0.01 - np.linalg.norm(last - bound.origin))
+        assert not bound.may_reach(T)
+
+
+def test_the_stand_is_the_same_with_and_without_the_chain_bound(monkeypatch):
+    """The dual-arm lift's stand and spots are found with 75 instead of 161 failing IK calls (5.2 s →
+    2.2 s CPU on the 2-core laptop): the bound only skips poses IK could not reach."""
+    from robocfg.kinematics.chain_bound import ChainBound
+    from robocfg.motion import placement
+
+    task = load_task(catalog.find("tasks", "pick_place"), robot_override="dual_arm_lift")
+    fast = placement._resolve(task, None)
+    monkeypatch.setattr(ChainBound, "may_reach", lambda self, T: True)
+    slow = placement._resolve(task, None)
+    assert fast.stand is not None and fast.stand == slow.stand
+    assert fast.params == slow.params and fast.note == slow.note

@@ -257,6 +257,7 @@ def arm_reach(task: CheckedTask, arm: str | None = None, robot: CheckedRobot | N
     object's grasp height and the pre-grasp height. ``robot``: another robot on the task's mount
     (default: the task's first robot); ``support_z``: the object rests at this height (m)
     everywhere (default: on the scene's support below each point)."""
+    from robocfg.kinematics.chain_bound import ChainBound
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.moves import bound_ik_by_iterations
     from robocfg.motion.reach import support_height
@@ -279,6 +280,7 @@ def arm_reach(task: CheckedTask, arm: str | None = None, robot: CheckedRobot | N
     R0 = quat_to_matrix(obj.quaternion_xyzw())
     grip = shape.below_origin(R0) + (shape.posed(R0)[:, 2].max() if isinstance(arm_cfg.gripper, SuctionGripperConfig) else 0.0)
     home = np.asarray(arm_cfg.home, float)
+    bound = ChainBound.of(model)  # poses the chain cannot stretch to are not asked of IK (same answer, no IK time)
 
     def reachable(d: float) -> bool:
         p = T_base[:3, 3] + d * forward
@@ -289,7 +291,8 @@ def arm_reach(task: CheckedTask, arm: str | None = None, robot: CheckedRobot | N
             for a in (0.5 * math.pi, 0.0):  # fingers closing across, then along, the forward direction
                 closing = math.cos(a) * forward + math.sin(a) * np.array([-forward[1], forward[0], 0.0])
                 g = Grasp(np.array([p[0], p[1], height]), grasp_rotation(down, closing), 0.0)
-                if model.ik(ee_pose_from_grasp(g, arm_cfg), seed_q=home, frame="ee", time_budget=IK_BUDGET).converged:
+                T = ee_pose_from_grasp(g, arm_cfg)
+                if bound.may_reach(T) and model.ik(T, seed_q=home, frame="ee", time_budget=IK_BUDGET).converged:
                     ok = True
                     break
             if not ok:
