@@ -162,6 +162,35 @@ def test_the_irb7600_circle_gets_the_largest_scale_ik_reaches():
     assert report.position_error_mm.rms < 5.0
 
 
+def test_the_auto_mapping_refuses_a_scale_the_controller_cannot_track(monkeypatch):
+    """With the old 0.1 steps the IRB 7600's circle was mapped at x0.9 of the reach ratio: IK reached
+    every point, but with the upper arm 0.1 mm from the wrist and through it (−4.1 mm), where the
+    controller holds its 20 mm self-collision margin and stalled (RMS 50 mm). The check now asks
+    each IK answer for the controller's margins (``controller_margins``): x0.9 is refused, x0.95
+    (closest pair 18.5 mm, within the 5 mm reach tolerance of the margin) is kept."""
+    import numpy as np
+
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.motion import relative
+    from robocfg.motion.targets import TargetMotion
+    from robocfg.runners.follow_target import POSE_SAMPLES, controller_margins, target_rotation
+
+    task = load_task(catalog.find("tasks", "follow_target"), robot_override="abb_irb7600")
+    params = task.config.follow_target
+    R, _ = target_rotation(task, None, params)
+    target = TargetMotion(params.motion, R)
+    poses = [target.pose(float(t)) for t in np.linspace(0.0, params.duration, POSE_SAMPLES)]
+    margins = controller_margins(task, None, params)
+    monkeypatch.setattr(relative, "SHRINK", (1.0, 0.9))
+    ik_only = relative.auto_map(task, None, poses, "circle", "tool")
+    assert ik_only is not None and "x0.9 of 3.60" in ik_only.note  # IK alone takes x0.9
+    assert relative.auto_map(task, None, poses, "circle", "tool", accept=margins) is None
+    monkeypatch.setattr(relative, "SHRINK", (1.0, 0.95, 0.9))
+    kept = relative.auto_map(task, None, poses, "circle", "tool", accept=margins)
+    assert kept is not None and "x0.95 of 3.60" in kept.note and "keeping the controller's margins" in kept.note
+
+
 def test_the_default_target_is_the_same_tool_pose_on_a_ur():
     """The default target_euler_deg [180, 0, 0] is read in the tool frame (``orientation_frame:
     tool``): on the UR5e, whose 2F-85 closes along tool0 x, that is the pose its home already holds

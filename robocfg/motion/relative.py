@@ -16,14 +16,17 @@ The mapped points are checked too: an arm's reachable set along a ray is not alw
 trajectory's direction, not 0.35-0.75 m), and along a ray the arm reaches nowhere there is no
 ratio at all (then 1). When some mapped point is out of IK reach, ``k`` steps down (``SHRINK``
 times the ratio) until every point is reached; when none works the points are left for the run
-to report unreachable.
+to report unreachable. A runner may ask more of each IK answer than reaching (``accept``):
+follow-target asks for the reactive controller's margins (see ``robocfg.runners.follow_target``),
+because IK reached every point of the IRB 7600's circle at x0.9 where the controller then stalled
+at its 20 mm self-collision margin (upper arm against the wrist, RMS 50 mm).
 
 Frames: world, metres.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,16 +62,18 @@ class PointMap:
 
 
 def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: str,
-             frame: str = "ee_link") -> PointMap | None:
+             frame: str = "ee_link", accept: Callable[[np.ndarray], bool] | None = None) -> PointMap | None:
     """The map for ``poses`` (4x4 world_T_tcp targets of the running robot's ``arm``, its TCP frame
     having ee_link's rotation), or None when that arm reaches every one, the file names the running
     robot itself, or no reach can be measured (the run then reports the unreachable points itself).
     ``frame``: what the task's orientations were written in; with ``tool`` the task's robot is
     measured with the same *tool* orientation (converted through each robot's ``R_ee_graspnet``),
-    with ``ee_link`` with the same ee_link rotation."""
+    with ``ee_link`` with the same ee_link rotation. ``accept``: what the runner needs of an IK
+    answer (joint values, arm order) besides reaching, e.g. the controller's margins; a point
+    whose answer it refuses counts as not reached (the reach ratio itself is measured by IK)."""
     ours_robot = task.robots[0]
     ours = _model(task, ours_robot, arm)
-    if all(_reaches(ours, ours_robot, arm, T) for T in poses):
+    if all(_reaches(ours, ours_robot, arm, T, accept) for T in poses):
         return None
     written = task.written_robot
     if written is None or written.resolve() == ours_robot.path.resolve():
@@ -92,13 +97,14 @@ def auto_map(task: CheckedTask, arm: str | None, poses: list[np.ndarray], what: 
     ratio = r_ours / r_theirs if measured else 1.0
     for f in SHRINK:
         m = PointMap(b_theirs, b_ours, ratio * f, "")
-        if all(_reaches(ours, ours_robot, arm, _moved(T, m)) for T in poses):
+        if all(_reaches(ours, ours_robot, arm, _moved(T, m), accept) for T in poses):
             break
     else:
         return None  # no scale reaches them all: the run names the unreachable points
     how = (f"reach {r_ours:.2f} m, the task's robot {theirs_robot.config.name}: {r_theirs:.2f} m" if measured
            else "no reach measured along the points' direction")
-    how += "" if f == 1.0 else f"; x{f:g} of {ratio:.2f}, the largest step at which IK reaches every point"
+    kept = "" if accept is None else " keeping the controller's margins"
+    how += "" if f == 1.0 else f"; x{f:g} of {ratio:.2f}, the largest step at which IK reaches every point{kept}"
     note = (f"placement auto: {what} moved to {ours_robot.config.name}'s arm ({how}): scaled x{m.scale:.2f} about its "
             f"base at [{b_ours[0]:.3f}, {b_ours[1]:.3f}, {b_ours[2]:.3f}] m")
     return PointMap(b_theirs, b_ours, m.scale, note)
@@ -120,9 +126,11 @@ def _model(task: CheckedTask, robot: CheckedRobot, arm: str | None):
     return model
 
 
-def _reaches(model, robot: CheckedRobot, arm: str | None, T: np.ndarray) -> bool:
+def _reaches(model, robot: CheckedRobot, arm: str | None, T: np.ndarray,
+             accept: Callable[[np.ndarray], bool] | None = None) -> bool:
     home = np.asarray(robot.config.arm(arm).home, float)
-    return bool(model.ik(T, seed_q=home, frame="tcp", time_budget=IK_BUDGET).converged)
+    res = model.ik(T, seed_q=home, frame="tcp", time_budget=IK_BUDGET)
+    return bool(res.converged) and (accept is None or bool(accept(np.asarray(res.q, float))))
 
 
 def _arm_base(model, robot: CheckedRobot, arm: str | None) -> np.ndarray:
