@@ -77,6 +77,29 @@ def test_expert_places_the_cube(robot):
     env.close()
 
 
+def test_an_arm_that_cannot_reach_the_floor_works_on_the_stand_run_adds():
+    """dual_arm_lift (arms 0.76 m up): the env resolves the pick_place task's placement as
+    ``run pick-place`` does, so the same stand is in its world and its workspace lies on the
+    stand's top; the expert places the cube there (on the floor the arm reached nothing)."""
+    from robocfg.checks import load_task
+    from robocfg.config import catalog
+    from robocfg.motion.placement import resolve_placement
+
+    stand = resolve_placement(load_task(catalog.find("tasks", "pick_place"), robot_override="dual_arm_lift")).stand
+    assert stand is not None
+    env = gym.make("robocfg/PickPlace-v0", robot="dual_arm_lift")
+    ws = env.unwrapped.workspace
+    assert "placement_stand/block" in env.unwrapped.world.bodies
+    assert ws.floor == pytest.approx(stand.position[2] + stand.size[2])
+    obs, info = env.reset(seed=0)
+    assert obs["achieved_goal"][2] == pytest.approx(ws.floor + 0.025, abs=2e-3)  # the cube rests on the stand
+    terminated = truncated = False
+    while not (terminated or truncated):
+        obs, _, terminated, truncated, info = env.step(env.unwrapped.expert_action())
+    assert info["is_success"], info
+    env.close()
+
+
 def test_joint_control_moves_the_commanded_joint():
     env = gym.make("robocfg/Reach-v0", robot="panda", control="joints")
     env.reset(seed=0)

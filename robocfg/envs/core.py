@@ -12,7 +12,10 @@ drives. ``control="joints"``: one value per arm joint, scaled by ``joint_step`` 
 Tasks that use the gripper add one last action: > 0 opens, < 0 closes (a parallel gripper takes
 the opening fraction ``(a + 1) / 2``; a suction cup switches on below zero).
 
-The workspace lies on the ground just beyond the robot's home TCP, so goals suit robots of any size. Each
+The workspace lies on the ground just beyond the robot's home TCP, so goals suit robots of any size;
+for an arm that cannot reach the ground (``dual_arm_lift``) the built-in pick_place task's
+placement resolution gives a stand, as ``run pick-place`` does (``robocfg.motion.placement``), and
+the workspace is its top (``Workspace.floor``). Each
 ``step`` advances ``step_time`` s of simulated time (0.04 s, panda-gym's default). ``reset``
 restores a physics snapshot taken once after building, so resets are cheap; ``reset(seed=…)``
 makes the episode reproducible.
@@ -43,10 +46,15 @@ class Workspace:
     """Axis-aligned region (world m) where goals and objects are sampled, on the ground just
     beyond the robot's home TCP; ``lo``/``hi`` bound the TCP targets."""
 
-    center: np.ndarray  # (3,) ground point a half-width beyond the home TCP, away from the base
+    center: np.ndarray  # (3,) point of the floor a half-width beyond the home TCP, away from the base
     half: float  # m, half side of the sampling square
     lo: np.ndarray  # (3,) lowest TCP target
     hi: np.ndarray  # (3,) highest TCP target
+
+    @property
+    def floor(self) -> float:
+        """Height (m) of the surface objects rest on: the ground, or the top of the placement stand."""
+        return float(self.center[2])
 
     def sample_xy(self, rng: np.random.Generator) -> np.ndarray:
         return self.center[:2] + rng.uniform(-self.half, self.half, size=2)
@@ -73,9 +81,15 @@ class RobotEnv(gym.Env):
         self.distance_threshold, self.ee_step, self.joint_step = distance_threshold, ee_step, joint_step
         self.render_size = render_size
         task = api.load_task("pick_place", robot=robot)
+        # the placement `run pick-place` resolves (on the task as loaded: it knows the robot the file
+        # was written for): a stand under the work area for an arm that cannot reach the floor (the
+        # spots themselves are the env's own, sampled below)
+        from robocfg.motion.placement import resolve_placement, with_stand
+
+        stand = resolve_placement(task).stand
         # physics step: the task's, shortened so that a whole number of them make ``step_time``
         self.substeps = max(1, int(np.ceil(step_time / task.config.sim.timestep - 1e-9)))
-        task = task.with_overrides({"sim.timestep": step_time / self.substeps})
+        task = with_stand(task.with_overrides({"sim.timestep": step_time / self.substeps}), stand)
         self.world = api.make_world(task)
         self.arm = self.world.robot.arm()
         self.gripper = self.arm.gripper
@@ -94,10 +108,14 @@ class RobotEnv(gym.Env):
         out = home_tcp[:2, 3] - self.world.robot.base_pose()[:2, 3]  # base → home TCP, horizontal
         reach = float(np.linalg.norm(out))
         half = float(np.clip(0.3 * reach, 0.08, 0.15))
-        # centred a half-width beyond the home TCP: close to the base, top-down poses run out
-        c = np.array([*(home_tcp[:2, 3] + half * out / max(reach, 1e-9)), 0.0])
+        if stand is None:  # centred a half-width beyond the home TCP: close to the base, top-down poses run out
+            c = np.array([*(home_tcp[:2, 3] + half * out / max(reach, 1e-9)), 0.0])
+        else:  # on the stand, objects whole on its top wherever they are sampled
+            sx, sy, sz = stand.size  # a block fixture's position: its footprint centre, at its bottom
+            c = np.array([stand.position[0], stand.position[1], stand.position[2] + sz])
+            half = min(half, max(0.0, min(sx, sy) / 2 - max(body.size[:2])))
         self.workspace = Workspace(c, half, c + np.array([-2 * half, -2 * half, 0.0]),
-                                   c + np.array([2 * half, 2 * half, max(0.3, 0.8 * home_tcp[2, 3])]))
+                                   c + np.array([2 * half, 2 * half, max(0.3, 0.8 * (home_tcp[2, 3] - c[2]))]))
         self.world.step(1)
         self._state = self.world.snapshot()
         self.goal = np.zeros(3)
@@ -164,7 +182,7 @@ class RobotEnv(gym.Env):
             from robocfg.sim.record_camera import CameraView
 
             c = self.workspace.center
-            cam = CameraView(target=(float(c[0]), float(c[1]), 0.15), distance=1.0 + 4 * self.workspace.half)
+            cam = CameraView(target=(float(c[0]), float(c[1]), float(c[2]) + 0.15), distance=1.0 + 4 * self.workspace.half)
             self._renderer = Recorder(self.world, "frame.png", size=self.render_size, camera=cam)
         return self._renderer.render()
 

@@ -22,7 +22,7 @@ class _ObjectEnv(RobotEnv):
     def _place_scene(self) -> None:
         rng, ws = self.np_random, self.workspace
         xy = ws.sample_xy(rng)
-        self.world.set_body_pose(self.object, [xy[0], xy[1], self.object_half_height])
+        self.world.set_body_pose(self.object, [xy[0], xy[1], ws.floor + self.object_half_height])
 
     def _achieved(self) -> np.ndarray:
         return self.world.body_pose(self.object)[0]
@@ -39,15 +39,15 @@ class _ObjectEnv(RobotEnv):
             xy = self.workspace.sample_xy(rng)
             if np.linalg.norm(xy - obj[:2]) >= min_distance:
                 break
-        return np.array([xy[0], xy[1], self.object_half_height])
+        return np.array([xy[0], xy[1], self.workspace.floor + self.object_half_height])
 
 
 class ReachEnv(RobotEnv):
-    """TCP to a goal point within the workspace (5–30 cm above the ground)."""
+    """TCP to a goal point within the workspace (5–30 cm above its floor: the ground, or the stand)."""
 
     def _sample_goal(self) -> np.ndarray:
         xy = self.workspace.sample_xy(self.np_random)
-        return np.array([xy[0], xy[1], self.np_random.uniform(0.05, 0.3)])
+        return np.array([xy[0], xy[1], self.workspace.floor + self.np_random.uniform(0.05, 0.3)])
 
 
 class PushEnv(_ObjectEnv):
@@ -88,7 +88,7 @@ class FollowTargetEnv(RobotEnv):
     def _sample_goal(self) -> np.ndarray:
         rng = self.np_random
         xy = self.workspace.sample_xy(rng) * 0.5 + self.workspace.center[:2] * 0.5
-        self._circle = (np.array([xy[0], xy[1], rng.uniform(0.15, 0.3)]), rng.uniform(0, 2 * np.pi))
+        self._circle = (np.array([xy[0], xy[1], self.workspace.floor + rng.uniform(0.15, 0.3)]), rng.uniform(0, 2 * np.pi))
         return self._on_circle(0.0)
 
     def _on_circle(self, t: float) -> np.ndarray:
