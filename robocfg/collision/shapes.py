@@ -87,7 +87,9 @@ def add_robot_geometry(geom_model, model, geoms: list[LinkGeometry]) -> int:
         shape = link_shape(g)
         if shape is None:
             continue
-        frame = model.frames[model.getFrameId(g.link)]
+        # the link's BODY frame: a joint may carry the link's name too (the Unitree Z1's gripperStator)
+        body = model.existFrame(g.link, pin.FrameType.BODY)
+        frame = model.frames[model.getFrameId(g.link, pin.FrameType.BODY) if body else model.getFrameId(g.link)]
         T = np.asarray(g.origin, dtype=float)
         placement = frame.placement * pin.SE3(T[:3, :3].copy(), T[:3, 3].copy())
         geom_model.addGeometryObject(pin.GeometryObject(f"{g.link}_{k}", frame.parentJoint, placement, shape))

@@ -60,6 +60,7 @@ class FollowLoop:
         self.moving = self._spawn(obstacles)
         self.ctrl = self._controller(obstacles)
         self.obstacle_ids = {n: world.bodies[n] for n in r.obstacles if n in world.bodies}
+        self.base_links = _base_links(task, world)
         self.env_ids = {n: world.bodies[n] for n in ENVIRONMENT if n in world.bodies}
         self.in_contact = False
         self._start_warnings()
@@ -206,9 +207,10 @@ class FollowLoop:
         return best
 
     def _touching(self, bodies: dict[str, int]) -> bool:
-        """Any penetrating contact between a moving robot link (not the base) and ``bodies``."""
+        """Any penetrating contact between a moving robot link (not the base nor a link fixed to
+        it) and ``bodies``."""
         robot = self.world.robot.body_id
-        return any(c.distance < 0.0 and c.link_a != -1
+        return any(c.distance < 0.0 and c.link_a not in self.base_links
                    for bid in bodies.values() for c in self.world.contact_points(robot, bid))
 
     def _start_warnings(self) -> None:
@@ -240,6 +242,22 @@ class FollowLoop:
         if self.failure is not None:
             raise RunFailed(self.failure.phase, self.failure.reason, report=r) from None
         return r
+
+
+def _base_links(task: CheckedTask, world: World) -> set[int]:
+    """PyBullet link indices of the robot's base (-1) and of every link joined to it by fixed
+    joints only: they do not move, so their contact with the ground they stand on is no robot
+    contact (the example-robot-data UR10's ``base_link`` hangs under a ``world`` root by a fixed
+    joint and counted every step)."""
+    urdf = task.robots[0].urdf
+    out = {-1}
+    for name, index in world.robot.link_index.items():
+        link, rigid = name, True
+        while rigid and (joint := urdf.joint_to_child(link)) is not None:
+            rigid, link = joint.type == "fixed", joint.parent
+        if rigid:
+            out.add(index)
+    return out
 
 
 def drive_target(q_end: np.ndarray, dq: np.ndarray, ctrl_dt: float, n_sub: int) -> np.ndarray:
