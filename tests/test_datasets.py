@@ -316,4 +316,37 @@ def test_an_episode_that_raises_leaves_no_recorder_hooked(tmp_path):
         with pytest.raises(RuntimeError, match="boom"):
             session.run(0)
         assert session.world.step_hooks == [] and "command" not in arm.__dict__
+        assert session.world.play_through is None
     assert sink.close().episodes_run == 0  # an episode that raised is not written
+
+
+@pytest.mark.parametrize("fmt", ["lerobot", "hdf5"])
+def test_recorded_moves_play_through_the_gate_bit_for_bit(tmp_path, monkeypatch, fmt):
+    """A recorded episode's moves are played by the recorder (``World.play_through``: the gate's
+    commands without per-step calls): the same report and the same dataset bytes as sending
+    every row through ``arm.command`` and ``world.step``."""
+    import dataclasses
+
+    import robocfg.sim.playback as playback
+    from robocfg.datasets.recorder import EpisodeRecorder
+
+    task = load_task(ROOT / "robocfg/data/tasks/pick_place.yaml")
+    task = dataclasses.replace(task, config=task.config.model_copy(update={"cameras": []}))
+
+    def record(root: Path):
+        sink = DatasetSink(root, fmt, task, keep="all", extra_info={"task_path": "pick_place.yaml", "seed": 1})
+        report, _ = run_pick_place(task, 2, seed=1, sink=sink)
+        sink.close()
+        return report, {f.relative_to(root): f.read_bytes() for f in sorted(root.rglob("*")) if f.is_file()}
+
+    played: list[int] = []
+    real = playback.play_latched
+    monkeypatch.setattr(playback, "play_latched", lambda *a: played.append(len(a[2])) or real(*a))
+    fast = record(tmp_path / "fast")
+    assert sum(played) > 1000  # most of the episodes' steps were played through the gate
+    monkeypatch.setattr(EpisodeRecorder, "play", lambda self, *a: False)
+    played.clear()
+    slow = record(tmp_path / "slow")
+    assert not played
+    assert fast[0] == slow[0] and all(e.success for e in fast[0].episodes)
+    assert fast[1].keys() == slow[1].keys() and fast[1] == slow[1]

@@ -32,6 +32,11 @@ class CommandGate:
         self._g_applied = OPEN  # a restored world starts with the gripper reset open
         self._prev = self._cur = self._round(np.append(self.q_wanted, OPEN))
         self._steps = np.arange(1, steps_per_frame + 1)[:, None] / steps_per_frame  # ramp fractions (n, 1)
+        # the current interval's arm targets for its steps 1..n (rad), their slope (rad/s), and
+        # whether they move (a held target is sent once per interval); set by ``latch``
+        self.ramp: list[list[float]] = []
+        self.slope: list[float] = []
+        self.moving = False
         self._interval = steps_per_frame * world.dt  # s between frames
         self._a = np.empty(len(arm.joints) + 1, np.float32)  # action k, filled in place
         self._real_command = arm.command
@@ -73,9 +78,9 @@ class CommandGate:
         prev = self._prev[:-1]
         delta = a[:-1] - prev
         # the interval's targets, computed once: the drives' per-step path then only sends them
-        self._ramp = (prev + self._steps * delta).tolist()
-        self._slope = (delta / self._interval).tolist()
-        self._moving = bool(delta.any())
+        self.ramp = (prev + self._steps * delta).tolist()
+        self.slope = (delta / self._interval).tolist()
+        self.moving = bool(delta.any())
         g = float(a[-1])
         real = self._real_open if g > 0 else self._real_close
         if g != self._g_applied and real is not None:
@@ -85,9 +90,9 @@ class CommandGate:
 
     def drive(self, j: int) -> None:
         """Send the arm targets for physics step ``j`` (1..steps_per_frame) of the current interval."""
-        if j > 1 and not self._moving:  # a held target is sent once per interval, not every step
+        if j > 1 and not self.moving:  # a held target is sent once per interval, not every step
             return
-        self._real_command(self._ramp[min(j, self.steps_per_frame) - 1], self._slope)
+        self._real_command(self.ramp[min(j, self.steps_per_frame) - 1], self.slope)
 
     @staticmethod
     def _round(a: np.ndarray) -> np.ndarray:

@@ -84,7 +84,18 @@ class EpisodeRecorder:
         self._frame(first=True)
         self.gate.drive(1)
         self.world.step_hooks.append(self.on_step)
+        self.world.play_through = self.play
         self._hooked = True
+
+    def play(self, arm, q_rows: list, qd_rows: list, after: Callable[[], None] | None) -> bool:
+        """``World.play`` of ``arm`` while recording: the same commands and frames as per row,
+        without the per-step calls (:func:`robocfg.sim.playback.play_latched`); False where it does
+        not apply (another arm, or another step hook besides this recorder)."""
+        from robocfg.sim.playback import play_latched
+
+        if arm is not self.arm or self.world.step_hooks != [self.on_step]:
+            return False
+        return play_latched(self.world, arm, q_rows, self.gate, self.n, self._frame, after)
 
     def on_step(self) -> None:
         j = self.world.steps % self.n
@@ -96,6 +107,8 @@ class EpisodeRecorder:
         """Unhook from the world's steps and give the commands back (idempotent)."""
         if self._hooked:
             self.world.step_hooks.remove(self.on_step)
+            if self.world.play_through == self.play:
+                self.world.play_through = None
             self._hooked = False
         self.gate.remove()
 

@@ -17,9 +17,10 @@ Three loops, the same commands and steps in each:
   change a gripper's or a drive's state, so skipping the no-op gripper updates is exact.
 * **hooked** — per step as :meth:`World.step` does it, with the motor settings re-read when a drive
   of the arm was replaced (by a hook, ``after`` or a gripper update).
+* **through** — an arm whose ``command`` is intercepted (a dataset's command gate) is played by the
+  interceptor's ``World.play_through`` when it offers one (:meth:`robocfg.datasets.recorder.EpisodeRecorder.play`).
 * **per row** — ``arm.command`` then ``world.step`` per row, where the fast paths do not apply: an
-  arm whose ``command`` is intercepted (a dataset's command gate), or joints with a speed cap or
-  no drive yet.
+  intercepted command without ``play_through``, or joints with a speed cap or no drive yet.
 
 ``advance_idle(world, n)`` is the bare loop without motor calls (``World.step`` uses it while no
 hook or busy gripper needs the steps one by one). The drives' recorded targets
@@ -30,7 +31,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 import pybullet as p
@@ -48,7 +49,10 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
     if q.ndim != 2 or q.shape[1] != len(key) or qd.shape != q.shape:
         raise ValueError(f"targets of shape {q.shape} and velocities of shape {qd.shape} for {len(key)} arm joints")
     q_rows, qd_rows = q.tolist(), qd.tolist()  # once, not per step
-    plan = None if "command" in vars(arm) else robot.motor_plan(key)
+    intercepted = "command" in vars(arm)
+    if intercepted and world.play_through is not None and world.play_through(arm, q_rows, qd_rows, after):
+        return
+    plan = None if intercepted else robot.motor_plan(key)
     if plan is None:
         for row, speeds in zip(q_rows, qd_rows):  # noqa: B905 - shapes checked above
             arm.command(row, speeds)
@@ -166,6 +170,72 @@ def advance_idle(world: World, n: int) -> None:
                 world.periodic_check()
     finally:
         world.physics_seconds += physics
+
+
+class Latched(Protocol):
+    """What :func:`play_latched` reads of a command gate (:class:`robocfg.datasets.gate.CommandGate`)."""
+
+    q_wanted: np.ndarray | list[float]  # the runner's latest arm command (latched at the next frame)
+    ramp: list[list[float]]  # this interval's arm targets for its steps 1..n (rad or m)
+    slope: list[float]  # their target velocity (rad/s or m/s)
+    moving: bool  # False: the held target is sent at the interval's first step only
+
+    def drive(self, j: int) -> None: ...  # send step j's targets through the arm's own command
+
+
+def play_latched(world: World, arm: ArmHandle, q_rows: list, gate: Latched, steps_per_frame: int,
+                 frame: Callable[[], None], after: Callable[[], None] | None) -> bool:
+    """Rows played through a command gate (a recorded episode) as ``arm.command(row)`` +
+    ``world.step()`` per row do while the gate's recorder is the only step hook: per step the row
+    becomes the gate's wish, physics steps, grippers update, the periodic check, a frame every
+    ``steps_per_frame`` steps (``frame()``: latch and sample), then the gate's ramp target of the
+    next step is sent (one motor call, settings looked up once; the gate's own ``drive`` when the
+    arm's drives have no fast plan). False (nothing played) when the arm's joints have none."""
+    robot, key = arm.robot, tuple(arm.joints)
+    plan = robot.motor_plan(key)
+    if plan is None:
+        return False
+    token, idx, kp, kd, force, drives = plan
+    current: MotorPlan | None = plan
+    body, client, mode = robot.body_id, robot.client, p.POSITION_CONTROL
+    send, tokens = p.setJointMotorControlArray, robot.drive_token
+    stepsim, clock, dt, every, n = p.stepSimulation, time.perf_counter, world.dt, world.check_every, steps_per_frame
+    grippers = world.grippers
+    sent: tuple[list[float], list[float]] | None = None
+    physics = 0.0
+    try:
+        for row in q_rows:
+            gate.q_wanted = row
+            t0 = clock()
+            stepsim(physicsClientId=client)
+            physics += clock() - t0
+            world.steps = steps = world.steps + 1
+            world.t = steps * dt
+            for g in grippers:
+                g.update()
+            if steps % every == 0:
+                world.periodic_check()
+            j = steps % n
+            if j == 0:
+                frame()
+            if j == 0 or gate.moving:  # the gate's drive(j + 1), inlined
+                if tokens(key) is not token:  # a drive was replaced (a gripper command at the frame)
+                    current = robot.motor_plan(key)
+                    if current is not None:
+                        token, idx, kp, kd, force, drives = current
+                if current is None:
+                    gate.drive(j + 1)
+                    sent = None
+                else:
+                    sent = (gate.ramp[j], gate.slope)
+                    send(body, idx, mode, sent[0], sent[1], force, kp, kd, client)
+            if after is not None:
+                after()
+    finally:
+        world.physics_seconds += physics
+        if sent is not None:
+            _remember(drives, *sent)
+    return True
 
 
 def _remember(drives: list[Drive], row: list[float], speeds: list[float]) -> None:

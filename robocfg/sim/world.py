@@ -76,6 +76,10 @@ class World(SceneQueries):
         # Called after every physics step (grippers updated, divergence checked), in order: what
         # samples an episode whatever code steps the world (a dataset recorder, robocfg.datasets.recorder).
         self.step_hooks: list[Callable[[], None]] = []
+        # Set while something intercepts the arm's commands and steps (a dataset recorder's command
+        # gate): ``play_through(arm, q_rows, qd_rows, after)`` plays rows exactly as ``arm.command``
+        # + ``step()`` per row would, and returns False where it cannot (then they are played per row).
+        self.play_through: Callable[[ArmHandle, list, list, Callable[[], None] | None], bool] | None = None
         self.warnings: list[str] = []
         self.bodies: dict[str, int] = {}
         self.shape_cache = ShapeCache()  # shapes of bodies added per episode, reused (PyBullet never frees them)
