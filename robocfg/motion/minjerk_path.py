@@ -67,6 +67,14 @@ class MinJerkPath(Trajectory):
         t_acc = np.sqrt(np.max((d2 * PEAK_SPEED**2 + d1 * PEAK_ACCEL) / limits.acceleration))
         self.duration = float(max(t_vel, t_acc, min_duration))
 
+    def positions_velocities(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """``evaluate(t)``'s (q, qd) by the same arithmetic, without the accelerations."""
+        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
+        tau = np.clip(tt / self.duration, 0.0, 1.0)
+        s = tau**3 * (10 - 15 * tau + 6 * tau**2)
+        sd = 30 * tau**2 * (1 - tau) ** 2 / self.duration
+        return self.spline(s), self.spline(s, 1) * sd[:, None]
+
     def _eval(self, t):
         T = self.duration
         tau = np.clip(t / T, 0.0, 1.0)

@@ -186,7 +186,7 @@ class ArmMover:
         statistics, so the per-step cost stays at one motor call)."""
         dt = self.world.dt
         n = math.ceil(traj.duration / dt - 1e-9)
-        q_ref, qd_ref, _ = traj.evaluate(np.arange(1, n + 1) * dt)
+        q_ref, qd_ref = traj.positions_velocities(np.arange(1, n + 1) * dt)
         self.world.play(self.arm, q_ref, qd_ref, self.on_step)
 
     def time_limit(self, planned: float | None, factor: float = 1.0) -> float:

@@ -25,6 +25,12 @@ class Trajectory:
         tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
         return self._eval(tt)
 
+    def positions_velocities(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(q, qd) at times ``t``, the same values as ``evaluate``'s first two; a subclass may skip
+        the accelerations (what a played move sends: position and velocity targets)."""
+        q, qd, _ = self.evaluate(t)
+        return q, qd
+
     def _eval(self, t: np.ndarray):  # pragma: no cover - abstract
         raise NotImplementedError
 
