@@ -12,7 +12,7 @@ from typing import Literal
 
 import numpy as np
 
-EnvKind = Literal["box", "sphere", "capsule", "cylinder", "halfspace"]
+EnvKind = Literal["box", "sphere", "capsule", "cylinder", "halfspace", "convex"]
 
 
 @dataclass
@@ -20,7 +20,9 @@ class EnvShape:
     """A world-fixed (or script-moved) shape the robot must keep away from.
 
     ``size``: box → full extents [x, y, z]; sphere → [radius]; capsule/cylinder → [radius, length]
-    (axis = the shape's z); halfspace → [] (the plane z = 0 of ``pose``, free side +z).
+    (axis = the shape's z); halfspace → [] (the plane z = 0 of ``pose``, free side +z);
+    convex → [] and ``vertices`` (N×3, m, in the shape's frame ``pose``): their convex hull (a
+    mesh or URDF body, as PyBullet collides a dynamic mesh).
     ``obstacle``: counted in the robot–obstacle clearance report (tables/ground are not).
     """
 
@@ -29,6 +31,7 @@ class EnvShape:
     size: tuple[float, ...]
     pose: np.ndarray = field(default_factory=lambda: np.eye(4))
     obstacle: bool = True
+    vertices: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -112,6 +115,10 @@ def coal_shape(shape: EnvShape):
         return coal.Cylinder(float(s[0]), float(s[1]))
     if shape.kind == "halfspace":
         return coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0)
+    if shape.kind == "convex":
+        if shape.vertices is None or len(shape.vertices) < 4:
+            raise ValueError(f"convex shape {shape.name!r} needs at least 4 vertices")
+        return hull(shape.vertices)
     raise ValueError(f"unknown environment shape kind {shape.kind!r}")
 
 

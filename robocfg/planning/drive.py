@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robocfg.collision import EnvShape
 from robocfg.errors import PhaseFailed
 from robocfg.planning.checker import CollisionChecker
 from robocfg.planning.planner import JointPlanner, PlannedPath, PlannerSettings, PlanningFailed
@@ -41,7 +41,8 @@ class PlannedDrive:
     planner: JointPlanner
     kin: KinematicModel
     ee_link: str
-    skipped: list[str]  # scene bodies the planner cannot see (meshes)
+    skipped: list[str]  # scene bodies the planner cannot see (none since meshes are convex hulls)
+    base_dir: Path = Path(".")  # resolves the task's relative mesh paths (the task file's folder)
     loose: list[str] = field(default_factory=list)  # scene.objects avoided where they lie at each move
     paths: list[PlannedPath] = field(default_factory=list)
 
@@ -50,14 +51,11 @@ class PlannedDrive:
         return self.planner.checker
 
     def attach(self, name: str, body: Body, T_ee_body: np.ndarray) -> None:
-        """Carry ``body`` at ``T_ee_body`` (4×4, its centre in the EE link frame, m)."""
-        from robocfg.motion.reactive_drive import bounding_radius
+        """Carry ``body`` at ``T_ee_body`` (4×4, its body frame in the EE link frame, m): its
+        primitive, or for a mesh or URDF body the convex hull of its collision geometry."""
+        from robocfg.collision.bodies import body_env_shape
 
-        if body.shape == "mesh":  # its extent is not known here: a bounding sphere of the scale box
-            shape = EnvShape(name, "sphere", (bounding_radius(body),), np.asarray(T_ee_body, float))
-        else:
-            shape = EnvShape(name, body.shape, tuple(body.size), np.asarray(T_ee_body, float))
-        self.checker.attach(name, shape, self.ee_link)
+        self.checker.attach(name, body_env_shape(body, T_ee_body, self.base_dir), self.ee_link)
 
     def detach(self, name: str) -> None:
         self.checker.detach(name)
@@ -155,19 +153,28 @@ def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
     ``objects`` (a command's own, e.g. pick_place_many's), avoided where they lie when each move
     starts, except while held; pick_place's object being picked is not among them."""
     from robocfg.collision import robot_geometry
-    from robocfg.motion.reactive.setup import body_shape, scene_shapes
+    from robocfg.collision.bodies import body_env_shape
+    from robocfg.geometry import pose_matrix, pose_to_matrix
+    from robocfg.motion.reactive.setup import scene_shapes
     from robocfg.planning.checker import DEFAULT_MARGIN
 
     links, _ = robot_geometry(robot)
     scene = world.task.config.scene
-    env, skipped = scene_shapes(scene)
+    base_dir = world.task.path.parent
+    env, unseen = scene_shapes(scene)
+
+    def where(body: Body) -> np.ndarray:  # a mesh's hull is in the body frame PyBullet reports
+        if body.name in world.bodies:
+            return pose_to_matrix(*world.body_pose(body.name))
+        return pose_matrix(body)
+
+    meshes = {b.name: b for b in scene.obstacles if b.shape == "mesh"}
+    env += [body_env_shape(meshes[name], where(meshes[name]), base_dir) for name in unseen if name in meshes]
+    skipped = [name for name in unseen if name not in meshes]
     loose = []
     for obj in [*scene.objects, *objects]:  # neighbours in clutter: kept clear of like obstacles
-        shape = body_shape(obj)
-        if shape is None:
-            skipped.append(obj.name)
-        else:
-            env.append(shape)
-            loose.append(obj.name)
+        env.append(body_env_shape(obj, where(obj), base_dir))
+        loose.append(obj.name)
     checker = CollisionChecker(kin, links, env, DEFAULT_MARGIN if margin is None else margin)
-    return PlannedDrive(JointPlanner(checker, kin.lower, kin.upper, settings), kin, kin.ee_link, skipped, loose)
+    return PlannedDrive(JointPlanner(checker, kin.lower, kin.upper, settings), kin, kin.ee_link, skipped,
+                        base_dir, loose)
