@@ -76,3 +76,43 @@ def test_a_loose_object_in_the_way_is_gone_round_not_pushed(task):
     assert episode.success, (episode.failed_phase, episode.reason)
     assert spy.checked > 500 and spy.robot_hits == 0 and spy.cube_hits == 0
     assert np.allclose(spy.block_at, block.position, atol=1e-3)
+
+
+def test_a_planned_move_carries_a_held_load_no_harder_than_the_grip_allows(task):
+    """``ArmMover.max_acceleration`` (what the grip carries, set after the grasp) bounds the EE's
+    acceleration on planned moves too: the planned, timed path is slowed uniformly along the same
+    joint path until the EE's peak acceleration (dense FK samples) is within it."""
+    from robocfg.config.commands import Limits
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.limits import limits_from_robot
+    from robocfg.motion.moves import ArmMover
+    from robocfg.planning.drive import build_planned_drive
+    from robocfg.sim.world import World
+
+    with World(task) as world:
+        arm = world.robot.arm()
+        kin = KinematicModel.from_robot(world.robot.checked)
+        limits = limits_from_robot(world.robot.checked, arm.joints, Limits())
+        mover = ArmMover(world, arm, kin, limits)
+        drive = build_planned_drive(world.robot.checked, world, kin)
+        q0 = arm.joint_positions()
+        T = kin.fk(q0, "ee")
+        T[:3, 3] += [0.0, 0.25, -0.1]
+        plan = drive.planner.timed(drive.planner.plan(q0, drive.goal(mover, T, q0)), limits)
+        free = plan.trajectory
+        assert mover.slowed_for_load(free) is free  # no load limit: unchanged
+
+        def peak(traj) -> float:
+            t = np.linspace(0.0, traj.duration, 801)
+            P = kin.fk_positions(traj.evaluate(t)[0], "ee")
+            return float(np.linalg.norm(np.diff(P, 2, axis=0), axis=1).max()) / (t[1] - t[0]) ** 2
+
+        mover.max_acceleration = 0.25 * peak(free)
+        slow = mover.slowed_for_load(free)
+        assert slow.duration > 1.9 * free.duration
+        assert peak(slow) <= 1.05 * mover.max_acceleration
+        for s in (0.0, 0.3, 0.7, 1.0):  # the same joint path, later
+            assert np.allclose(slow.evaluate(s * slow.duration)[0], free.evaluate(s * free.duration)[0])
+        t0 = world.t
+        drive.move(mover, T)  # the drive plays the slowed timing
+        assert world.t - t0 >= slow.duration - world.dt

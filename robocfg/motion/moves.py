@@ -28,6 +28,7 @@ from robocfg.geometry import rotation_angle
 if TYPE_CHECKING:
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import JointLimits
+    from robocfg.motion.trajectory import Trajectory
     from robocfg.sim.gripper.base import Gripper
     from robocfg.sim.robot import ArmHandle
     from robocfg.sim.world import World
@@ -170,6 +171,16 @@ class ArmMover:
             reason = check()
             if reason:
                 raise MoveFailed(self.phase, reason)
+
+    def slowed_for_load(self, traj: Trajectory) -> Trajectory:
+        """``traj`` slowed uniformly (same path) so that the EE's peak acceleration stays within
+        ``max_acceleration`` (what the grip carries); ``traj`` itself when that is None or already met."""
+        from robocfg.motion.trajectory import Slowed
+
+        if self.max_acceleration is None or traj.duration <= 0:
+            return traj
+        k = self._stretch(traj, self.max_acceleration)
+        return traj if k <= 1.0 else Slowed(traj, k)
 
     def _stretch(self, traj, a_max: float) -> float:
         """Factor (≥ 1) by which to slow ``traj`` so that the EE's peak acceleration (m/s², from

@@ -65,6 +65,18 @@ class TimeScaled(Trajectory):
                 np.atleast_2d(self.f(u, 2)) / self.k**2)
 
 
+class Slowed(Trajectory):
+    """``inner`` played ``k`` ≥ 1 times slower along the same path: q(t) = inner(t/k), velocities
+    scaled by 1/k, accelerations by 1/k²."""
+
+    def __init__(self, inner: Trajectory, k: float):
+        self.inner, self.k, self.duration = inner, float(k), float(inner.duration) * float(k)
+
+    def _eval(self, t):
+        q, qd, qdd = self.inner.evaluate(t / self.k)
+        return q, qd / self.k, qdd / self.k**2
+
+
 class Piecewise(Trajectory):
     """Consecutive trajectories played one after the other."""
 

@@ -132,13 +132,15 @@ class PlannedDrive:
         except PlanningFailed as exc:
             raise PhaseFailed(mover.phase, exc.reason) from None
         self.paths.append(path)
-        plan = self.planner.timed(path, mover.limits)
-        if mover.timeout is not None and plan.duration > mover.timeout:
-            raise PhaseFailed(mover.phase, f"motion needs {plan.duration:.2f} s, more than the {mover.timeout:.2f} s timeout")
+        # a held object is carried no harder than the grip holds it (the mover's max_acceleration),
+        # as on every other timed move: uniformly slower along the same (checked) path
+        traj = mover.slowed_for_load(self.planner.timed(path, mover.limits).trajectory)
+        if mover.timeout is not None and traj.duration > mover.timeout:
+            raise PhaseFailed(mover.phase, f"motion needs {traj.duration:.2f} s, more than the {mover.timeout:.2f} s timeout")
         t_start = mover.world.t
-        if plan.duration > 0:
-            mover.play(plan.trajectory)
-        mover.converge(T_goal, t_start, mover.time_limit(plan.duration))
+        if traj.duration > 0:
+            mover.play(traj)
+        mover.converge(T_goal, t_start, mover.time_limit(traj.duration))
         if check is not None:
             reason = check()
             if reason:
