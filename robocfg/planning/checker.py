@@ -19,6 +19,7 @@ the hand holding it. Frames: world, 4×4 transforms, metres; joint values in arm
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -198,7 +199,8 @@ class CollisionChecker:
         and at both ends, tested middle-first so that a blocked segment is rejected early."""
         qa, qb = np.asarray(qa, float), np.asarray(qb, float)
         n = max(1, int(np.ceil(float(np.max(np.abs(qb - qa))) / step)))
-        return all(self.is_valid(qa + (qb - qa) * (s / n)) for s in _bisection_order(n))
+        states = qa + (qb - qa) * (_bisection_order(n)[:, None] / n)  # all at once: the same values
+        return all(self.is_valid(q) for q in states)
 
     def _label(self, gid: int) -> str:
         name = self.geom.geometryObjects[gid].name
@@ -209,8 +211,10 @@ class CollisionChecker:
         return name.rsplit("_", 1)[0]  # link name (geometries are named link_index)
 
 
-def _bisection_order(n: int) -> list[int]:
-    """0..n, ends first, then midpoints of ever finer halves."""
+@functools.lru_cache(maxsize=256)
+def _bisection_order(n: int) -> np.ndarray:
+    """0..n, ends first, then midpoints of ever finer halves (cached: segments of a path repeat
+    their lengths, and building the order in Python cost ≈ 0.2 ms per segment)."""
     order, seen = [0, n], {0, n}
     spans = [(0, n)]
     while spans:
@@ -223,4 +227,6 @@ def _bisection_order(n: int) -> list[int]:
                     order.append(m)
                 nxt += [(a, m), (m, b)]
         spans = nxt
-    return order
+    out = np.asarray(order, float)
+    out.flags.writeable = False
+    return out
