@@ -40,6 +40,8 @@ RELEASE_CLEARANCE = 0.001
 ROLLING_FRICTION = 1e-3
 REST_TOLERANCE = 1e-4  # m: an object spawned further than this from resting on its support is moved onto it
 REST_CONTACT = 0.002  # m: an object no higher than this above resting on the support at the place point is set down
+RELEASE_STILL = 1e-3  # opening fraction: fingers moving less than this per poll are not moving
+RELEASE_STALL = 0.1  # s: fingers not moving this long, short of open, while opening have stalled
 
 
 class _StateMachine(GraspChoice):
@@ -199,12 +201,27 @@ class _StateMachine(GraspChoice):
                  f"be accelerated up to {a:.1f} m/s²")
 
     def _release(self) -> None:
+        """Open until the object is free and the fingers are 90 % open. Fingers that stop short of
+        open (``RELEASE_STALL`` s without moving) while the object is still between them get their
+        contacts with it rebuilt from the geometry (:meth:`~robocfg.sim.gripper.base.Gripper.refresh_contacts`:
+        PyBullet can keep a contact point whose normal turned round, which holds them shut), and
+        so do fingers open but still touching it, before the hand moves away (such a point drags
+        the object up with them)."""
         t0 = self.world.t
         self.gripper.open()
+        last, still = self.gripper.fraction(), 0.0
         while self._held() or self.gripper.fraction() < 0.9:
             if self.world.t - t0 > self.params.timeouts.release:
                 raise MoveFailed("release", "the object did not come free")
             self.mover.step(SETTLE_POLL)
+            now = self.gripper.fraction()
+            still = still + SETTLE_POLL * self.world.dt if abs(now - last) < RELEASE_STILL else 0.0
+            last = now
+            if still >= RELEASE_STALL and self.gripper.refresh_contacts(self.obj):
+                self.log(f"  release: the fingers stopped at {now:.0%} open; their contacts with the object rebuilt")
+                still = 0.0
+        if self.gripper.refresh_contacts(self.obj, touching_only=True):
+            self.log("  release: a finger still touched the object when open; its contacts rebuilt")
 
     def _dropped(self) -> str | None:
         if self._held():

@@ -65,6 +65,13 @@ class Gripper(ABC):
     def set_force(self, force: float) -> None:  # noqa: B027 (no-op by design for grippers without a force)
         """Cap the grip force (N, or N·m). Grippers without a force setting (suction) ignore it."""
 
+    def refresh_contacts(self, body: int | str, touching_only: bool = False) -> bool:
+        """Rebuild the finger links' contact points with ``body`` from the current geometry
+        (:meth:`robocfg.sim.queries.SceneQueries.refresh_contacts`); ``touching_only``: only if a
+        finger touches it. Returns whether they were rebuilt; a gripper without finger links
+        (suction) has none to rebuild."""
+        return False
+
     @abstractmethod
     def fraction(self) -> float:
         """Measured opening, 0 (closed) to 1 (open)."""

@@ -148,6 +148,13 @@ class ParallelGripper(Gripper):
         bid = self._body_id(body)
         return [len(p.getContactPoints(self.robot.body_id, bid, f, physicsClientId=self.client)) for f in self.fingers]
 
+    def refresh_contacts(self, body: int | str, touching_only: bool = False) -> bool:
+        bid = self._body_id(body)
+        if touching_only and not self.world.touching(self.robot.body_id, bid, self.fingers):
+            return False
+        self.world.refresh_contacts(self.robot.body_id, bid, self.fingers)
+        return True
+
     def is_grasping(self, body: int | str) -> bool:
         """Both finger links touch ``body`` (a body id or a world body name)."""
         bid = self._body_id(body)
