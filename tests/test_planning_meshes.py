@@ -122,3 +122,32 @@ def test_a_held_duck_is_its_hull_not_a_bounding_sphere(scene):
         assert checker.is_valid(kin.home) is free
         if not free:
             assert any(c.a == "held object 'duck'" and c.b == "plate" for c in checker.contacts(kin.home))
+
+
+def _clear_table_with_a_duck(tmp_path, position) -> object:
+    """clear_table with its red box and a duck (scale 1) at ``position`` (the bin holds two of
+    the duck's 69 mm footprint)."""
+    import yaml
+
+    task = load_task(catalog.find("tasks", "clear_table"))
+    data = yaml.safe_load(task.path.read_text())
+    objects = data["pick_place_many"]["objects"]
+    duck = {"name": "duck", "shape": "mesh", "mesh": "pybullet_data://duck_vhacd.urdf", "size": [1.0, 1.0, 1.0],
+            "position": list(position), "region": {"xy_range": [0.004, 0.004]}}
+    data["pick_place_many"]["objects"] = [o for o in objects if o["name"] == "red"] + [duck]
+    path = tmp_path / "clear_duck.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_a_duck_is_checked_by_its_geometry_not_by_its_scale(tmp_path):
+    """``size`` of a mesh is a scale: a duck at scale 1 (≈ 8 × 8 × 6 cm) on the table is not
+    "inside" the bin 0.45 m away (its scale read as a 1 m box was), and one standing in the
+    bin's wall still is."""
+    from robocfg.errors import ConfigError
+
+    task = load_task(_clear_table_with_a_duck(tmp_path, [0.45, -0.4, TABLE_TOP + 0.03]))
+    assert [o.name for o in task.config.pick_place_many.objects][-1] == "duck"
+    with pytest.raises(ConfigError) as exc:
+        load_task(_clear_table_with_a_duck(tmp_path, [0.5, 0.05, TABLE_TOP + 0.03]))  # on bin/wall_-y
+    assert any("'duck'" in p.message and "bin/wall_-y" in p.message for p in exc.value.problems)

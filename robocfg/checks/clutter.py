@@ -121,10 +121,10 @@ def check_many(doc: YamlDocument, scene: Scene, params: PickPlaceManyParams) -> 
         problems.append(doc.problem((*loc_place, "gap"), f"{f.name!r} holds {len(spots.points)} of the "
                                     f"{len(params.objects)} objects ({max(radii) * 1000:.0f} mm footprint radius, "
                                     f"gap {place.gap * 1000:.0f} mm)"))
-    regions = [_region_box(o, r, (*BLOCK, "objects", k, "region")) for k, (o, r) in enumerate(zip(params.objects, radii, strict=True))]
+    regions = [_region_box(o, r, (*BLOCK, "objects", k, "region"), base) for k, (o, r) in enumerate(zip(params.objects, radii, strict=True))]
     parts = [_box(p, ("scene", "fixtures", k)) for k, fx in enumerate(scene.fixtures) for p in fx.parts()]
-    parts += [_box(b, ("scene", "obstacles", k)) for k, b in enumerate(scene.obstacles)]
-    parts += [_box(b, ("scene", "objects", k)) for k, b in enumerate(scene.objects)]
+    parts += [_box(b, ("scene", "obstacles", k), base) for k, b in enumerate(scene.obstacles)]
+    parts += [_box(b, ("scene", "objects", k), base) for k, b in enumerate(scene.objects)]
     for (o, reg) in zip(params.objects, regions, strict=True):
         hit = max(((p, overlap_depth(reg, p)) for p in parts), key=lambda t: t[1], default=None)
         if hit is not None and hit[1] > TOLERANCE:
@@ -138,9 +138,9 @@ def check_many(doc: YamlDocument, scene: Scene, params: PickPlaceManyParams) -> 
     return problems
 
 
-def _region_box(o: PickObject, radius: float, loc: Loc) -> _Box:
+def _region_box(o: PickObject, radius: float, loc: Loc, base_dir: Path) -> _Box:
     """The box (world, axis-aligned) an object can occupy anywhere in its region, any yaw in range."""
-    b = _box(o, loc)
+    b = _box(o, loc, base_dir)
     half_z = float(np.sum(b.h * np.abs(b.R[2])))  # the object's half height as it is turned
     h = np.array([o.region.xy_range[0] + radius, o.region.xy_range[1] + radius, half_z])
     return _Box(o.name, loc, np.eye(3), b.c, h)

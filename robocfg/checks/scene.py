@@ -11,6 +11,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -39,17 +40,32 @@ def _half_extents(b: Body) -> np.ndarray:
     return np.array([s[0], s[0], s[1] / 2 + (s[0] if b.shape == "capsule" else 0.0)])
 
 
-def _box(b: Body, loc: tuple) -> _Box:
+def _box(b: Body, loc: tuple, base_dir: Path | None = None) -> _Box:
     """The body's bounding box in the world. A body turned by ``euler_deg`` (or not at all) uses
     the closed-form roll-pitch-yaw matrix: importing scipy's ``Rotation`` would be most of the
-    time ``validate`` takes to reject a task; quaternions go through it."""
+    time ``validate`` takes to reject a task; quaternions go through it. A mesh or URDF body
+    (``size`` is its scale, not its extents) gets the box of its collision geometry
+    (:func:`robocfg.assets.object_shape.object_shape`, relative paths from ``base_dir``) about
+    that geometry's centre; a mesh that cannot be read keeps the scale box (the asset checks
+    report the file)."""
     from robocfg.geometry import quat_to_matrix, rpy_matrix
 
     if b.quat_xyzw is None and b.quat_wxyz is None:
         R = rpy_matrix(*np.radians(b.euler_deg or [0.0, 0.0, 0.0]))
     else:
         R = quat_to_matrix(b.quaternion_xyzw())
-    return _Box(b.name, loc, R, np.asarray(b.position, dtype=float), _half_extents(b))
+    c = np.asarray(b.position, dtype=float)
+    if b.shape == "mesh":
+        from robocfg.assets.object_shape import object_shape
+        from robocfg.assets.paths import UnresolvedPath
+
+        try:
+            v = object_shape(b, base_dir or Path(".")).vertices
+        except (UnresolvedPath, OSError, ValueError):
+            return _Box(b.name, loc, R, c, _half_extents(b))
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        return _Box(b.name, loc, R, c + R @ ((lo + hi) / 2), (hi - lo) / 2)
+    return _Box(b.name, loc, R, c, _half_extents(b))
 
 
 def overlap_depth(a: _Box, b: _Box) -> float:
@@ -92,7 +108,7 @@ def check_scene(doc: YamlDocument, scene: Scene, extra: Sequence[tuple[Loc, Body
     things = [(loc, b, "object") for loc, b in movable] + \
              [(("scene", "obstacles", k), b, "obstacle") for k, b in enumerate(scene.obstacles)]
     for loc, body, what in things:
-        inside = _deepest([_box(body, (*loc, "position"))], fixture_boxes)
+        inside = _deepest([_box(body, (*loc, "position"), doc.path.parent)], fixture_boxes)
         if inside is not None:
             box, part, depth = inside
             problems.append(doc.problem(box.loc, f"{what} {body.name!r} is inside fixture part {part.name!r} "
