@@ -129,7 +129,7 @@ class FollowTargetParams(Frozen):
         "auto", description="The TCP's turn about the tool axis (ee_axis). tracked: the whole target orientation is "
                             "followed and measured. symmetric: the tool looks the same turned half a turn about its "
                             "axis (two jaws closing symmetrically), so of the target and the target turned half a turn, "
-                            "the one nearer the arm's home orientation is tracked. free: the tool is symmetric about "
+                            "the one clearly nearer (by > 10°) the arm's home orientation is tracked. free: the tool is symmetric about "
                             "its axis, so only where it points is followed and measured (orientation error = angle "
                             "between the tool axes). auto: free for a suction gripper, symmetric for a parallel "
                             "gripper, tracked otherwise (a one-jaw gripper, no gripper).")

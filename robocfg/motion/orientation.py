@@ -16,6 +16,7 @@ controller; ``tracked`` follows the target as written. Frames: world; rotations 
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -33,6 +34,7 @@ if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
 
 ToolRoll = Literal["tracked", "symmetric", "free"]
+CLEARLY_NEARER = math.radians(10.0)  # rad by which the half-turned target must be nearer the start to be taken
 
 
 def resolved_tool_roll(setting: str, arm: ArmConfig) -> ToolRoll:
@@ -62,11 +64,12 @@ def ee_target_rotation(R: np.ndarray, arm: ArmConfig, frame: str, roll: ToolRoll
                        start: np.ndarray | None = None) -> tuple[np.ndarray, bool]:
     """(world_R_ee for the task rotation ``R`` written in ``frame``, whether it was turned half a
     turn). With ``roll == "symmetric"`` and the arm's start rotation ``start``, the half-turned
-    rotation is taken when it is nearer ``start`` (strictly: a tie keeps ``R``)."""
+    rotation is taken when it is nearer ``start`` by more than ``CLEARLY_NEARER`` (a target about a
+    quarter turn from the start either way is kept as written: a near tie must not flip on rounding)."""
     R_ee = ee_rotation(R, arm, frame)
     if roll != "symmetric" or start is None:
         return R_ee, False
     turned = half_turn(R_ee, arm)
-    if rotation_angle(start, turned) < rotation_angle(start, R_ee):
+    if rotation_angle(start, turned) + CLEARLY_NEARER < rotation_angle(start, R_ee):
         return turned, True
     return R_ee, False
