@@ -49,3 +49,22 @@ def test_a_started_ray_pool_runs_on_the_actors_it_started():
     finally:
         ray.shutdown()
     assert out.records == alone.records and out.report == alone.report and not out.lost
+
+
+def test_a_local_ray_started_for_the_run_gives_its_actors_the_drivers_niceness():
+    """Ray's own default starts workers at niceness 15, where an actor yields its core to every
+    ordinary process (a pool worker, another job): the local Ray that ``--executor ray`` starts
+    runs them at the driver's niceness, as a process pool's workers run."""
+    import os
+
+    recipe = _recipe(1)
+    assert not ray.is_initialized()
+    pool = RayPool(1)
+    pool.start(recipe)  # starts a local Ray, as the CLI does without --ray-address
+    try:
+        assert [s.niceness for s in pool.starts] == [os.nice(0)]
+        out = pool.run(recipe, plan_batches(1, 1, False))
+    finally:
+        if ray.is_initialized():
+            ray.shutdown()
+    assert not out.lost and len(out.records) == 1

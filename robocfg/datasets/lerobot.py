@@ -14,8 +14,16 @@ which a robocfg run reaches only at tens of thousands of episodes)::
 Depth (a camera with ``depth: true``) is a float32 feature ``observation.depth.<camera>`` of shape
 (H, W) in the data parquet, metres along the optical axis, stored exactly (a fixed-size list of
 fixed-size lists: what ``LeRobotDataset`` loads as a ``datasets.Array2D``); its statistics are one
-(1, 1) figure each over every pixel (:class:`~robocfg.datasets.stats.DepthStats`). Depth frames are
-held in memory until ``close()`` (64 KiB a frame at 128×128).
+(1, 1) figure each over every pixel (:class:`~robocfg.datasets.stats.DepthStats`, running sums and a
+1 mm histogram, so no frame is kept for them).
+
+The data parquet is streamed: each episode's rows are buffered and written as a row group once
+the buffer holds ``ROW_GROUP_BYTES`` (and at ``close()``), so a writer holds at most that much of
+the frames' data, whatever the number of episodes (depth is 64 KiB a frame at 128×128). Where to
+cut depends only on the episodes in order, so a merged dataset cuts where a single process does.
+A dataset under ``ROW_GROUP_BYTES`` (state only: tens of thousands of frames) is one row group,
+as ``pyarrow.parquet.write_table`` writes it. The vector features (state, actions: ≈ 150 bytes a
+frame) are also kept until ``close()``, for their exact quantiles in ``stats.json``.
 
 Timestamps are ``frame_index / fps``; an episode's video frames start at its
 ``videos/<key>/from_timestamp``. Videos: H.264 (libx264), yuv420p, a keyframe every 2 frames
@@ -41,6 +49,7 @@ CODEBASE_VERSION = "v3.0"
 DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
 EPISODES_PATH = "meta/episodes/chunk-000/file-000.parquet"
+ROW_GROUP_BYTES = 32 << 20  # frame data buffered before it is written as one parquet row group
 STATE, ENV, ACTION = "observation.state", "observation.environment_state", "action"
 ACTION_JOINT, ACTION_EE = "action.joint", "action.ee_delta"  # the second action feature (--dataset-actions)
 
@@ -96,8 +105,10 @@ class LeRobotWriter:
                                                                          file_index=0), layout.fps)
                        for c in layout.cameras}
         self.image_stats = {c.name: ImageStats() for c in layout.cameras}
-        self.depth: dict[str, list[np.ndarray]] = {c.name: [] for c in layout.cameras if c.depth}  # (T, H, W) m
-        self.depth_stats = {name: DepthStats() for name in self.depth}
+        self.depth_stats = {c.name: DepthStats() for c in layout.cameras if c.depth}
+        self._pending: list[pa.Table] = []  # episodes' data rows not yet written
+        self._pending_bytes = 0
+        self._parquet: pq.ParquetWriter | None = None
 
     def add(self, ep: EpisodeRecord) -> None:
         """Append an episode with its raw images (encoded here, one segment per camera)."""
@@ -109,16 +120,19 @@ class LeRobotWriter:
         """Append an episode whose camera frames are already encoded (``ep.images`` is not read;
         their statistics come separately, :meth:`add_image_histograms`); depth from ``ep.depth``."""
         n, k = ep.length, len(self.episodes)
-        for name, frames in self.depth.items():
-            d = np.asarray(ep.depth[name], np.float32)
-            frames.append(d)
+        depth = {name: np.asarray(ep.depth[name], np.float32) for name in self.depth_stats}
+        for name, d in depth.items():
             self.depth_stats[name].add(d)
         task_index = self.tasks.setdefault(ep.language, len(self.tasks))
+        cols: dict[str, np.ndarray] = {}
         for key, arr in ((STATE, ep.state), (ENV, ep.env_state), ("phase_index", ep.phase), *self._actions(ep)):
+            cols[key] = arr
+        cols["episode_index"] = np.full(n, k, np.int64)
+        cols["frame_index"] = np.arange(n, dtype=np.int64)
+        cols["task_index"] = np.full(n, task_index, np.int64)
+        for key, arr in cols.items():
             self.columns[key].append(arr)
-        self.columns["episode_index"].append(np.full(n, k, np.int64))
-        self.columns["frame_index"].append(np.arange(n, dtype=np.int64))
-        self.columns["task_index"].append(np.full(n, task_index, np.int64))
+        self._add_rows(self._rows(cols, depth, self.frames, n))
         row = {"episode_index": k, "tasks": [ep.language], "length": n,
                "data/chunk_index": 0, "data/file_index": 0,
                "dataset_from_index": self.frames, "dataset_to_index": self.frames + n}
@@ -133,6 +147,42 @@ class LeRobotWriter:
                 "run_episode": ep.index, "physics_steps": ep.physics_steps, "object_final": ep.object_final}
         self.episodes.append(row)
         self.frames += n
+
+    def _rows(self, cols: dict[str, np.ndarray], depth: dict[str, np.ndarray], first: int, n: int) -> pa.Table:
+        """The data rows of ``n`` frames (dataset indices ``first`` on): ``cols`` the vector and
+        index columns, ``depth`` camera → (n, H, W) m."""
+        fps = self.layout.fps
+        arrays = {key: _fixed_list(np.asarray(cols[key]).reshape(n, d), d) for key, d in vector_dims(self.layout).items()}
+        arrays |= {
+            "timestamp": pa.array((cols["frame_index"] / fps).astype(np.float32)),
+            "frame_index": pa.array(cols["frame_index"].astype(np.int64)),
+            "episode_index": pa.array(cols["episode_index"].astype(np.int64)),
+            "index": pa.array(np.arange(first, first + n, dtype=np.int64)),
+            "task_index": pa.array(cols["task_index"].astype(np.int64)),
+            "phase_index": pa.array(cols["phase_index"].astype(np.int64)),
+        }
+        for c in self.layout.cameras:
+            if c.depth:
+                arrays[depth_key(c.name)] = _fixed_list(depth[c.name].reshape(n, c.height, c.width), c.width, c.height)
+        return pa.table(arrays)
+
+    def _add_rows(self, rows: pa.Table) -> None:
+        """Buffer an episode's rows; write the buffer as a row group once it holds ``ROW_GROUP_BYTES``."""
+        self._pending.append(rows)
+        self._pending_bytes += rows.nbytes
+        if self._pending_bytes >= ROW_GROUP_BYTES:
+            self._flush()
+
+    def _flush(self) -> None:
+        if not self._pending:
+            return
+        table = pa.concat_tables(self._pending).combine_chunks()
+        self._pending, self._pending_bytes = [], 0
+        if self._parquet is None:
+            path = self.root / DATA_PATH.format(chunk_index=0, file_index=0)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            self._parquet = pq.ParquetWriter(path, table.schema)
+        self._parquet.write_table(table)
 
     def _actions(self, ep: EpisodeRecord) -> list[tuple[str, np.ndarray]]:
         """(feature key, (T, D) array) of the episode's actions as the layout stores them."""
@@ -156,31 +206,26 @@ class LeRobotWriter:
         """Write the parquet files and metadata; returns the dataset root."""
         for v in self.videos.values():
             v.close()
-        fps = self.layout.fps
+        self._flush()
+        if self._parquet is not None:
+            self._parquet.close()
+            self._parquet = None
+        else:  # no episode: the columns with no row
+            empty = {k: np.zeros(0) for k in self.columns}
+            depth = {c.name: np.zeros((0, c.height, c.width)) for c in self.layout.cameras if c.depth}
+            _write(self._rows(empty, depth, 0, 0), self.root / DATA_PATH.format(chunk_index=0, file_index=0))
         cols = {k: np.concatenate(v) if v else np.zeros(0) for k, v in self.columns.items()}
         n = self.frames
         dims = vector_dims(self.layout)
-        arrays = {key: _fixed_list(cols[key].reshape(n, d), d) for key, d in dims.items()}
-        arrays |= {
-            "timestamp": pa.array((cols["frame_index"] / fps).astype(np.float32)),
-            "frame_index": pa.array(cols["frame_index"].astype(np.int64)),
-            "episode_index": pa.array(cols["episode_index"].astype(np.int64)),
-            "index": pa.array(np.arange(n, dtype=np.int64)),
-            "task_index": pa.array(cols["task_index"].astype(np.int64)),
-            "phase_index": pa.array(cols["phase_index"].astype(np.int64)),
-        }
-        for c in self.layout.cameras:
-            if c.depth:
-                d = np.concatenate(self.depth[c.name]) if self.depth[c.name] else np.zeros((0, c.height, c.width))
-                arrays[depth_key(c.name)] = _fixed_list(d.reshape(n, c.height, c.width), c.width, c.height)
-        _write(pa.table(arrays), self.root / DATA_PATH.format(chunk_index=0, file_index=0))
         _write(pa.Table.from_pylist(self.episodes) if self.episodes else pa.table({"episode_index": pa.array([], pa.int64())}),
                self.root / EPISODES_PATH)
         _write_tasks(self.tasks, self.root / "meta/tasks.parquet")
         stats = {key: vector_stats(cols[key].reshape(n, d)) for key, d in dims.items()} if n else {}
         if n:
+            scalars = {"timestamp": (cols["frame_index"] / self.layout.fps).astype(np.float32),
+                       "index": np.arange(n, dtype=np.int64)}
             for key in ("timestamp", "frame_index", "episode_index", "index", "task_index", "phase_index"):
-                stats[key] = vector_stats(np.asarray(arrays[key]))
+                stats[key] = vector_stats(scalars[key] if key in scalars else cols[key].astype(np.int64))
             stats |= {image_key(c): s.result() for c, s in self.image_stats.items()}
             stats |= {depth_key(c): s.result() for c, s in self.depth_stats.items()}
         _json(self.root / "meta/stats.json", stats)

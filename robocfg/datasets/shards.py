@@ -12,7 +12,9 @@ the episodes were spread over workers.
 
 from __future__ import annotations
 
+import itertools
 import shutil
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,8 +28,9 @@ from robocfg.datasets.stats import ImageStats
 @dataclass(frozen=True)
 class Shard:
     """One closed shard: where it is, its format, the layout of its episodes (None when no episode
-    was run into it), episodes run and kept, frames, and its cameras' colour histograms
-    (camera → (3, 256) counts, with the number of frames they cover)."""
+    was run into it), episodes run and kept, frames, its cameras' colour histograms (camera →
+    (3, 256) counts, with the number of frames they cover) and the run's indices of the episodes
+    it holds, in order."""
 
     path: str
     fmt: Format
@@ -37,6 +40,7 @@ class Shard:
     frames: int
     image_hist: dict[str, np.ndarray] = field(default_factory=dict)
     image_frames: dict[str, int] = field(default_factory=dict)
+    indices: tuple[int, ...] = ()
 
 
 def close_shard(sink: DatasetSink) -> Shard:
@@ -47,7 +51,8 @@ def close_shard(sink: DatasetSink) -> Shard:
     stats = getattr(sink.writer, "image_stats", None) or {}
     for name, s in stats.items():
         hist[name], frames[name] = s.hist.copy(), s.frames
-    return Shard(str(sink.root), sink.fmt, sink.layout, sink.run, sink.kept, sink.frames, hist, frames)
+    return Shard(str(sink.root), sink.fmt, sink.layout, sink.run, sink.kept, sink.frames, hist, frames,
+                 tuple(sink.kept_indices))
 
 
 def merge_shards(shards: list[Shard], out: Path, fmt: Format, extra_info: dict,
@@ -61,25 +66,38 @@ def merge_shards(shards: list[Shard], out: Path, fmt: Format, extra_info: dict,
         return DatasetSummary(str(out), fmt, 0, run, 0)
     layout = layouts[0]
     writer = make_writer(fmt, out, layout, extra_info)
-    episodes = []
-    for s in shards:
-        if s.episodes_kept:
-            episodes += _read_lerobot(s, layout) if fmt == "lerobot" else _read_hdf5(s, layout)
-    episodes.sort(key=lambda e: e[0].index)
-    frames = 0
-    for ep, videos in episodes:
+    frames = kept = 0
+    for ep, videos in _in_order([s for s in shards if s.episodes_kept], layout):
         if fmt == "lerobot":
             writer.add_encoded(ep, videos)
         else:
             writer.add(ep)
         frames += ep.length
+        kept += 1
     if fmt == "lerobot":
         writer.add_image_histograms(_summed_histograms(shards))
     writer.close()
     if remove:
         for s in shards:
             shutil.rmtree(s.path, ignore_errors=True)
-    return DatasetSummary(str(out), fmt, len(episodes), run, frames)
+    return DatasetSummary(str(out), fmt, kept, run, frames)
+
+
+def _in_order(shards: list[Shard], layout: DatasetLayout) -> Iterator[tuple[EpisodeRecord, dict]]:
+    """Every episode of ``shards`` ordered by its index in the run. Shards whose index ranges do
+    not interleave (a run's batches are consecutive ranges) are read one at a time, so the merge
+    holds one shard's frames at most; otherwise all are read, then sorted."""
+    def read(s: Shard) -> list[tuple[EpisodeRecord, dict]]:
+        return _read_lerobot(s, layout) if s.fmt == "lerobot" else _read_hdf5(s, layout)
+
+    ordered = sorted(shards, key=lambda s: s.indices[0] if s.indices else -1)
+    apart = all(s.indices and list(s.indices) == sorted(s.indices) for s in ordered) and all(
+        a.indices[-1] < b.indices[0] for a, b in itertools.pairwise(ordered))
+    if not apart:
+        yield from sorted((e for s in shards for e in read(s)), key=lambda e: e[0].index)
+        return
+    for s in ordered:
+        yield from read(s)
 
 
 def _summed_histograms(shards: list[Shard]) -> dict[str, ImageStats]:

@@ -70,6 +70,7 @@ class DatasetSink:
     run: int = field(default=0, init=False)
     kept: int = field(default=0, init=False)
     frames: int = field(default=0, init=False)
+    kept_indices: list[int] = field(default_factory=list, init=False)  # run episode indices written, in order
     _rig: tuple | None = field(default=None, init=False)
     _fk: dict[str, Callable] = field(default_factory=dict, init=False)  # arm name -> base_T_tcp(q)
 
@@ -111,6 +112,7 @@ class DatasetSink:
         if success or self.keep == "all":
             self.writer.add(ep)
             self.kept += 1
+            self.kept_indices.append(index)
             self.frames += ep.length
 
     def close(self) -> DatasetSummary:

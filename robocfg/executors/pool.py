@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import multiprocessing as mp
 import signal
+import time
 import traceback
 from collections import deque
 from collections.abc import Callable
@@ -29,8 +30,10 @@ from robocfg.executors.session import (
     EpisodeRun,
     Recipe,
     ReportRequest,
+    WorkerStart,
     report_in_driver,
     run_batch,
+    worker_start,
 )
 
 POLL = 0.5  # s: how often the driver looks at the stop request while waiting
@@ -45,9 +48,10 @@ def _worker_main(conn: Connection, recipe: Recipe) -> None:
     """A worker: open the recipe once, then run the batches it is sent (and make the report when
     asked) until it is sent None."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    opening = time.time()
     try:
         session = recipe.open()
-        conn.send(("ready", None))  # the world is built: what ProcessPool.start waits for
+        conn.send(("ready", worker_start(opening)))  # the world is built: what ProcessPool.start waits for
         try:
             while (msg := conn.recv()) is not None:
                 if isinstance(msg, ReportRequest):
@@ -80,6 +84,7 @@ class ProcessPool:
             raise RobocfgError(f"--workers {workers}: need at least 1")
         self.workers = workers
         self.pids: list[int] = []  # the worker processes' ids, once started
+        self.starts: list[WorkerStart] = []  # how each worker started, filled by start()
         self._started: tuple[Recipe, list[_Worker]] | None = None
 
     def start(self, recipe: Recipe) -> None:
@@ -88,6 +93,7 @@ class ProcessPool:
         benchmark times it apart from the episodes). Optional: ``run`` starts them itself."""
         pool = self._spawn(recipe, self.workers)
         self._started = (recipe, pool)
+        self.starts = []
         try:
             for w in pool:
                 while not w.ready:
@@ -98,6 +104,8 @@ class ProcessPool:
                     if msg[0] == "error":
                         raise WorkerError(f"worker {w.process.pid} failed: {msg[1]}\n{msg[2]}")
                     w.ready = msg[0] == "ready"
+                    if w.ready:
+                        self.starts.append(msg[1])
         except BaseException:
             self._started = None
             for w in pool:

@@ -11,12 +11,20 @@ surfaces as ``RayActorError`` on its calls: those batches are reported lost and 
 Where Ray runs: ``address`` (``--ray-address``), else ``RAY_ADDRESS``, else a local Ray started
 here and shut down after the run. A Ray already initialised in this process (a test, a notebook)
 is used as it is.
+
+Priority: Ray starts its worker processes at niceness 15 (its ``worker_niceness`` setting), so
+an actor yields its core to any ordinary process — on a shared host, or beside a process pool,
+it ran at a fraction of a pool worker's speed for the same CPU time per episode. A local Ray
+started here runs its workers at the driver's niceness (``worker_niceness`` 0), as a pool's
+workers run; a cluster started by ``ray start`` keeps its own setting (``RAY_worker_niceness=0``
+in the environment of ``ray start`` gives the same; ``docs/scale-out.md``).
 """
 
 from __future__ import annotations
 
 import logging
 import os
+import time
 from collections import deque
 from collections.abc import Callable
 from typing import Any
@@ -29,22 +37,30 @@ from robocfg.executors.session import (
     BatchDone,
     EpisodeRun,
     Recipe,
+    WorkerStart,
     report_in_driver,
     run_batch,
+    worker_start,
 )
 
 IN_FLIGHT = 2  # actor calls queued per actor: it never waits for the driver between batches
+WORKER_NICENESS = 0  # niceness increment of a local Ray's workers (Ray's own default: 15)
 
 
 class _Actor:
     """A Ray actor holding one session."""
 
     def __init__(self, recipe: Recipe):
+        opening = time.time()
         self.recipe = recipe
         self.session = recipe.open()
+        self.start = worker_start(opening)
 
     def pid(self) -> int:
         return os.getpid()
+
+    def started(self) -> WorkerStart:
+        return self.start
 
     def run(self, batch: Batch) -> BatchDone:
         return run_batch(self.session, self.recipe.dataset, batch)
@@ -61,6 +77,7 @@ class RayPool:
             raise RobocfgError(f"--workers {workers}: need at least 1")
         self.workers, self.address = workers, address
         self.actors: list[Any] = []
+        self.starts: list[WorkerStart] = []  # how each actor started, filled by start()
         self._started: tuple[Recipe, bool] | None = None  # the actors' recipe, and whether Ray was started here
 
     def start(self, recipe: Recipe) -> None:
@@ -74,7 +91,7 @@ class RayPool:
         self._start_actors(ray, recipe, self.workers)
         self._started = (recipe, started)
         try:
-            ray.get([a.pid.remote() for a in self.actors])
+            self.starts = ray.get([a.started.remote() for a in self.actors])
         except RayActorError as exc:
             self._started = None
             self._stop(ray, started)
@@ -161,9 +178,18 @@ def _init(ray: Any, address: str | None) -> bool:
     shut down after the run)."""
     if ray.is_initialized():
         return False
-    address = address or os.environ.get("RAY_ADDRESS") or None
-    ray.init(address=address, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False)
+    init_ray(ray, address or os.environ.get("RAY_ADDRESS") or None)
     return True
+
+
+def init_ray(ray: Any, address: str | None = None, num_cpus: int | None = None) -> None:
+    """``ray.init`` as ``--executor ray`` calls it: no dashboard, workers' logs not copied to the
+    driver; with no ``address`` a local Ray (``num_cpus`` CPUs, default all) whose workers run at
+    the driver's niceness (:data:`WORKER_NICENESS`; see the module docstring)."""
+    kwargs: dict[str, Any] = {}
+    if address in (None, "local"):  # a new Ray on this machine (Ray's own reading of "local")
+        kwargs = {"num_cpus": num_cpus, "_system_config": {"worker_niceness": WORKER_NICENESS}}
+    ray.init(address=address, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False, **kwargs)
 
 
 def _report_of(ray: Any, actors: list[Any], recipe: Recipe, result: Execution) -> Any:

@@ -11,6 +11,7 @@ own shard.
 from __future__ import annotations
 
 import dataclasses
+import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -87,9 +88,11 @@ class EngineSession:
     def run(self, k: int, sink: DatasetSink | None = None) -> EpisodeRun:
         if self.switch is not None:
             self.switch.target = sink
+        cpu, thread = time.process_time(), time.thread_time()
         record = self.session.run(k)
+        cpu, thread = time.process_time() - cpu, time.thread_time() - thread
         t = self.session.timing
-        return EpisodeRun(record, t.per_episode[-1], t.physics_per_episode[-1])
+        return EpisodeRun(record, t.per_episode[-1], t.physics_per_episode[-1], cpu, thread)
 
     def report(self, records: list[Any], interrupted: bool) -> Any:
         return self.session.report(records, interrupted)

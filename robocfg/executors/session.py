@@ -66,11 +66,16 @@ class Recipe(Protocol):
 @dataclass(frozen=True)
 class EpisodeRun:
     """One finished episode: its record (the report's entry), wall time (s) and the part of it spent
-    stepping the physics (s)."""
+    stepping the physics (s); ``cpu``: the worker process's CPU time over the episode (s, user +
+    system, every thread: a Ray actor's own threads included), ``thread_cpu``: the part on the
+    thread that ran it (s). CPU times do not count time spent waiting for a core, so they compare
+    executors on a loaded machine where wall times do not."""
 
     record: Any
     wall: float
     physics: float
+    cpu: float = 0.0
+    thread_cpu: float = 0.0
 
     @property
     def index(self) -> int:
@@ -116,11 +121,52 @@ class Batch:
 
 @dataclass
 class BatchDone:
-    """A committed batch: its episodes' runs in index order and the shard they were recorded to."""
+    """A committed batch: its episodes' runs in index order and the shard they were recorded to;
+    ``pid``: the worker process that ran it, ``cpu``: that process's CPU time (s, all threads) when
+    the batch began and when it ended (a benchmark sums a worker's CPU between batches from them)."""
 
     batch: Batch
     runs: list[EpisodeRun]
     shard: Shard | None
+    pid: int = 0
+    cpu: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class WorkerStart:
+    """When a worker started (wall clock, s since the epoch): its process was created
+    (``created``), it began opening the recipe (``opening``: the interpreter, its imports and the
+    recipe's unpickling done) and its session was open (``ready``: world, model and controllers
+    built); ``niceness``: its scheduling niceness (a higher one yields the CPU to other processes)."""
+
+    pid: int
+    created: float
+    opening: float
+    ready: float
+    niceness: int = 0
+
+
+def worker_start(opening: float) -> WorkerStart:
+    """This process's :class:`WorkerStart`, its session having opened just now."""
+    import os
+    import time
+
+    return WorkerStart(os.getpid(), _created(), opening, time.time(), os.nice(0))
+
+
+def _created() -> float:
+    """When this process was created (s since the epoch, 10 ms steps; Linux ``/proc``; NaN elsewhere)."""
+    import os
+    import time
+
+    try:
+        with open("/proc/self/stat") as f:
+            ticks = int(f.read().rsplit(")", 1)[1].split()[19])  # field 22: start time in clock ticks
+        with open("/proc/uptime") as f:
+            uptime = float(f.read().split()[0])  # s since boot, 10 ms steps
+        return time.time() - uptime + ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return float("nan")
 
 
 @dataclass(frozen=True)
@@ -142,8 +188,12 @@ def plan_batches(episodes: int, workers: int, recording: bool) -> list[Batch]:
 def run_batch(session: Session, dataset: DatasetTarget | None, batch: Batch,
               on_episode: Callable[[EpisodeRun], None] | None = None) -> BatchDone:
     """Run ``batch`` in ``session``; with a dataset, record it into the batch's shard and close it."""
+    import os
+    import time
+
     from robocfg.datasets.shards import close_shard
 
+    cpu0 = time.process_time()
     sink = dataset.sink(session.task, dataset.shard_root(batch.id)) if dataset is not None else None
     runs = []
     for k in batch.indices:
@@ -151,7 +201,8 @@ def run_batch(session: Session, dataset: DatasetTarget | None, batch: Batch,
         runs.append(run)
         if on_episode is not None:
             on_episode(run)
-    return BatchDone(batch, runs, close_shard(sink) if sink is not None else None)
+    shard = close_shard(sink) if sink is not None else None
+    return BatchDone(batch, runs, shard, os.getpid(), (cpu0, time.process_time()))
 
 
 def report_in_driver(recipe: Recipe, records: list[Any], interrupted: bool) -> Any:
