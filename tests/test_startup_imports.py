@@ -77,16 +77,18 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     assert {"pybullet", "pinocchio", "robocfg.motion.cubic"} <= names  # the probe sees the episode's modules
     assert _heavy(names, [*NEVER, "scipy.interpolate", "scipy.spatial", "scipy.optimize", "scipy.sparse"]) == []
     assert "scipy.linalg" not in names and "scipy.linalg._flapack" in names  # LAPACK without scipy.linalg
+    assert "scipy" not in names  # nor scipy's __init__ (its version checks)
     assert [m for m in OTHER_KINDS if m in names] == []  # the registry loaded this kind's runner only
     ik = {"robocfg.kinematics.ik.lm", "robocfg.kinematics.ik.pink_qp", "robocfg.kinematics.ik.placo_qp"}
     assert ik & names == {"robocfg.kinematics.ik.lm"}  # the IK backend it solves with, not the QP ones
 
 
 def test_lapack_routines_are_scipys_own_functions(tmp_path) -> None:
-    """Loaded before ``scipy.linalg``, the routines are the objects scipy.linalg.lapack then
+    """Loaded before ``scipy`` (its ``__init__`` not run), the routines are the objects scipy.linalg.lapack then
     gives (the same results); and they solve."""
     code = ("import numpy as np; from robocfg.geometry.lapack import lapack; import sys\n"
-            "dposv, dgtsv = lapack('dposv'), lapack('dgtsv'); assert 'scipy.linalg' not in sys.modules\n"
+            "dposv, dgtsv = lapack('dposv'), lapack('dgtsv')\n"
+            "assert 'scipy.linalg' not in sys.modules and 'scipy' not in sys.modules  # nor scipy's __init__\n"
             "H, g = np.array([[4.0, 1.0], [1.0, 3.0]]), np.array([1.0, 2.0])\n"
             "assert np.allclose(H @ dposv(H, g)[1], g)\n"
             "import scipy.linalg.lapack as l; assert l.dposv is dposv and l.dgtsv is dgtsv")
