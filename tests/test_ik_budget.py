@@ -135,3 +135,25 @@ def test_with_an_iteration_budget_the_clock_ends_no_search(model: KinematicModel
         assert a.iterations == b.iterations and a.restarts == b.restarts
         assert np.array_equal(a.q, b.q)
     assert loaded[0].iterations == BUDGET and loaded[0].restarts >= 1
+
+
+def test_lm_first_descent_ignores_a_spent_time_budget(model: KinematicModel) -> None:
+    """A process paused past its whole time budget (a loaded machine) still gets the descent from
+    the seed: a target 11 cm from home converges, FK of the answer on the target; the budget then
+    stops the restarts of an unreachable target after the first descent."""
+    solver = model.solver("lm")
+    clock = solver.clock
+    ticks = iter(range(10**6))
+    solver.clock = lambda: float(next(ticks))  # every reading is a second past the last: budget spent
+    try:
+        target = model.fk(model.home)
+        target[:3, 3] += [0.05, 0.0, -0.10]
+        res = model.ik(target, model.home, time_budget=0.02)
+        far = model.fk(model.home)
+        far[:3, 3] += [3.0, 0.0, 0.0]
+        lost = model.ik(far, model.home, time_budget=0.02)
+    finally:
+        solver.clock = clock
+    assert res.converged and res.restarts == 0
+    np.testing.assert_allclose(model.fk(res.q)[:3, 3], target[:3, 3], atol=1e-4)
+    assert not lost.converged and lost.restarts <= 1

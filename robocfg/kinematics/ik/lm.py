@@ -78,7 +78,7 @@ class LMSolver:
             return self._descend(q, Mt, fid, position_only, deadline, self.max_iter if cap is None else min(self.max_iter, cap))
 
         best_q, iters, restarts = search(km, descend, q0, deadline, rng, self.clock, self.max_total_iter,
-                                         lambda rng: self._restart(rng, Mt, fid, position_only))
+                                         lambda rng: self._restart(rng, Mt, fid, position_only), whole_first=True)
         return finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only,
                       self.tol_pos, self.tol_rot, t0, iters, restarts)
 
