@@ -4,24 +4,34 @@ loaded machine wall time mostly measures the other jobs).
 
     python benchmarks/bench_control_cost.py --episodes 16 [--task pick_place] [--formats lerobot,hdf5] [--json out.json]
 
-One process, one session per row of the same task (seed 0): episode k runs without a dataset and
-then with a state-only dataset of each of ``--formats`` (default: lerobot; ``--formats ""``: none),
-in turn, so machine load falls on all alike; figures are medians over episodes 1..N (episode 0
-warms up, and with it the writer's first use: its imports and the file it opens). The cost of a
-format is the median of per-episode CPU ratios (dataset / none); what a run pays once per format —
-the writer module's first import (h5py for hdf5), opening the writer and its ``close()`` — is
-measured apart (CPU ms, ``fixed_ms``).
+One process, one session per row of the same task (seed 0). Episode k (1..N; episode 0 warms up,
+and with it the writer's first use: its imports and the file it opens) runs three ways, in an
+order that rotates with k, so machine load falls on all alike:
 
-The buckets wrap the named functions with ``process_time`` (nested calls count once, in the outer
-bucket): the motor calls themselves (``setJointMotorControlArray``/``setJointMotorControl2``, arm
-and gripper, wherever robocfg sends them), the divergence checks, IK, the grasp choice, min-jerk
-timing, trajectory sampling, gripper updates; "other" is the rest of the episode (the step loop,
-world restore, spawning the object, the state machine's own checks). The timers cost CPU
-themselves (≈ 1–4 µs a call, ≈ 4 000 calls an episode, which would add ≈ 5–10 % to "own" on a
-2-core laptop): the benchmark measures its wrapper on a no-op before the episodes and removes,
-per call, the part that fell inside a timed interval from that interval and the rest from "own"
-("timer_overhead_ms" says how much). robocfg's own work = (episode CPU − timer overhead −
-``stepSimulation``) ÷ ``stepSimulation``, the issue's "own work ÷ physics time".
+* **untimed** — nothing wrapped: the episode's CPU;
+* **physics** — ``stepSimulation`` alone wrapped (the fewest timers): the episode's physics CPU;
+* **buckets** — every function of ``BUCKETS`` wrapped too, without a dataset and then with a
+  state-only dataset of each of ``--formats`` (default: lerobot; ``--formats ""``: none).
+
+The headline, robocfg's own work ÷ physics (the issue's "own work ÷ physics time"), is the median
+over k of (untimed CPU − physics CPU) ÷ physics CPU: no timer's cost is in it. The same ratio
+from the physics and the buckets runs (their timers' CPU, calibrated on a no-op before the
+episodes, removed) is printed as a cross-check: it comes out higher, because a timer costs more in
+situ (after a physics step, with cold caches) than in the calibration loop.
+
+The buckets are **exclusive**: a bucket's time excludes the wrapped calls inside it (IK inside the
+grasp choice counts as IK), and what no bucket holds is "other". Besides the main costs (motor
+calls, divergence checks, IK, grasp choice, min-jerk timing, trajectory sampling, gripper
+updates) they name the rest of the episode: the step loop (playback and the world's step), the
+straight lines' waypoints (IK aside), move set-up, convergence and gripper polls, support ray
+casts, the world restore, the object spawn, the episode set-up, state reads, the episode record.
+Bucket figures carry their timers' in-situ excess (≈ 1 µs or more per wrapped call beyond the
+calibration), so buckets with many calls (the step loop holds each physics step's timer exit,
+motor calls are ≈ one a step) read high; compare them with each other and across code versions,
+and take the headline from the untimed run. The cost of a format is the median of per-episode CPU
+ratios (dataset / none, both bucketed); what a run pays once per format — the writer module's
+first import (h5py for hdf5), opening the writer and its ``close()`` — is measured apart (CPU
+ms, ``fixed_ms``).
 """
 
 from __future__ import annotations
@@ -38,89 +48,160 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
-BUCKETS = (  # (module, class or None for a module function, function, label)
+BUCKETS = (  # (module, class or None for a module function, function, label); exclusive (see Meter)
     ("pybullet", None, "setJointMotorControlArray", "motor calls"),
     ("pybullet", None, "setJointMotorControl2", "motor calls"),
     ("robocfg.sim.world", "World", "_check", "divergence checks"),
     ("robocfg.kinematics.model", "KinematicModel", "ik", "IK"),
-    ("robocfg.runners.pick_place_machine", "_StateMachine", "_choose_grasp", "grasp choice"),
+    ("robocfg.runners.pick_place_grasp_choice", "GraspChoice", "_choose_grasp", "grasp choice"),
     ("robocfg.motion.minjerk_path", "MinJerkPath", "__init__", "min-jerk timing"),
+    ("robocfg.motion.minjerk_path", "MinJerkPath", "positions_velocities", "trajectory sampling"),
     ("robocfg.motion.trajectory", "Trajectory", "evaluate", "trajectory sampling"),
     ("robocfg.sim.gripper.parallel", "ParallelGripper", "update", "gripper update"),
+    # the rest of the episode, by part ("other" is what none of these holds):
+    ("robocfg.sim.playback", None, "_play_bare", "step loop"),
+    ("robocfg.sim.playback", None, "_play_hooked", "step loop"),
+    ("robocfg.sim.playback", None, "advance_idle", "step loop"),
+    ("robocfg.sim.playback", None, "play_rows", "step loop"),
+    ("robocfg.sim.world", "World", "step", "step loop"),
+    ("robocfg.sim.world", "World", "periodic_check", "step loop"),
+    ("robocfg.motion.moves", "ArmMover", "straight_waypoints", "straight lines (IK aside)"),
+    ("robocfg.motion.moves", "ArmMover", "move", "move set-up"),
+    ("robocfg.motion.moves", "ArmMover", "play", "move set-up"),
+    ("robocfg.motion.moves", "ArmMover", "_stretch", "move set-up"),
+    ("robocfg.motion.moves", "ArmMover", "converge", "convergence polls"),
+    ("robocfg.motion.moves", "ArmMover", "close_until_held", "gripper polls"),
+    ("robocfg.runners.pick_place_machine", "_StateMachine", "_release", "gripper polls"),
+    ("robocfg.sim.gripper.parallel", "ParallelGripper", "is_grasping", "gripper polls"),
+    ("robocfg.sim.gripper.parallel", "ParallelGripper", "width", "gripper polls"),
+    ("robocfg.sim.gripper.parallel", "ParallelGripper", "fraction", "gripper polls"),
+    ("robocfg.sim.gripper.parallel", "ParallelGripper", "set_fraction", "gripper commands"),
+    ("robocfg.sim.gripper.parallel", "ParallelGripper", "set_force", "gripper commands"),
+    ("robocfg.sim.gripper.parallel", "ParallelGripper", "reset", "gripper commands"),
+    ("robocfg.runners.pick_place_machine", "_StateMachine", "_support_height", "support ray casts"),
+    ("robocfg.engine.session", "EpisodeSession", "_reset", "world restore"),
+    ("robocfg.sim.world", "World", "add_body", "object spawn"),
+    ("robocfg.runners.pick_place", None, "episode_setup", "episode set-up"),
+    ("robocfg.runners.pick_place_machine", "_StateMachine", "__init__", "episode set-up"),
+    ("robocfg.sim.robot", "RobotHandle", "link_pose", "state reads"),
+    ("robocfg.sim.robot", "RobotHandle", "joint_positions", "state reads"),
+    ("robocfg.sim.world", "World", "body_pose", "state reads"),
+    ("robocfg.runners.pick_place_machine", "_StateMachine", "result", "episode record"),
 )
 
 
+_INHERITED = object()  # a wrapped attribute that its holder inherited (uninstall deletes it)
+
+
 class Meter:
-    """CPU seconds per label; ``stepSimulation`` and the bucket functions wrapped. ``calls``
-    counts the timed calls per label, ``passed`` the nested ones that only passed through."""
+    """CPU seconds per label, **exclusive**: a wrapped call charges its label with its CPU time
+    minus that of the wrapped calls inside it, which charge theirs (the stack's top is charged;
+    the episode itself is the bottom, ``other``). ``stepSimulation`` and the bucket functions are
+    wrapped. ``calls[label]``: timed calls of the label; ``inner[label]``: wrapped calls made
+    while it was on top (each leaves part of the wrapper's own cost in it)."""
 
     def __init__(self) -> None:
         self.acc: dict[str, float] = defaultdict(float)
         self.calls: dict[str, int] = defaultdict(int)
-        self.passed = 0
-        self._depth = 0
-        self.cost_in = self.cost_out = self.cost_pass = 0.0  # s per call, from calibrate()
+        self.inner: dict[str, int] = defaultdict(int)
+        self._stack: list[str] = ["other"]
+        self._mark = time.process_time()
+        self.cost_in = self.cost_out = 0.0  # s per call, from calibrate()
+        self._wrapped: list[tuple[Any, str, Any, Any, str]] = []  # (holder, name, its own attribute, function, label)
 
     def timed(self, f: Any, label: str) -> Any:
-        def timed(*a: Any, **k: Any) -> Any:
-            if self._depth:
-                self.passed += 1
-                return f(*a, **k)
-            self._depth += 1
-            c0 = time.process_time()
+        stack, acc, calls, inner, clock = self._stack, self.acc, self.calls, self.inner, time.process_time
+
+        def timed(*a: Any, **k: Any) -> Any:  # one clock reading at each end: every µs lands in some label
+            t = clock()
+            top = stack[-1]
+            acc[top] += t - self._mark
+            self._mark = t
+            inner[top] += 1
+            stack.append(label)
             try:
                 return f(*a, **k)
             finally:
-                self.acc[label] += time.process_time() - c0
-                self.calls[label] += 1
-                self._depth -= 1
+                t = clock()
+                acc[label] += t - self._mark
+                self._mark = t
+                calls[label] += 1
+                stack.pop()
 
         return timed
 
     def wrap(self, holder: Any, name: str, label: str) -> None:
-        setattr(holder, name, self.timed(getattr(holder, name), label))
+        self._wrapped.append((holder, name, vars(holder).get(name, _INHERITED), getattr(holder, name), label))
 
-    def install(self) -> None:
+    def install(self, physics_only: bool = False) -> None:
+        """Wrap ``stepSimulation`` and the buckets' functions (again, after ``uninstall``);
+        ``physics_only``: ``stepSimulation`` alone."""
         import pybullet
 
-        self.wrap(pybullet, "stepSimulation", "stepSimulation")
-        for mod, cls, fn, label in BUCKETS:
-            m = importlib.import_module(mod)
-            self.wrap(m if cls is None else getattr(m, cls), fn, label)
+        if not self._wrapped:
+            self.wrap(pybullet, "stepSimulation", "stepSimulation")
+            for mod, cls, fn, label in BUCKETS:
+                m = importlib.import_module(mod)
+                self.wrap(m if cls is None else getattr(m, cls), fn, label)
+        for holder, name, _, f, label in self._wrapped:
+            if physics_only and label != "stepSimulation":
+                continue
+            setattr(holder, name, self.timed(f, label))
+
+    def uninstall(self) -> None:
+        """Put the functions back as they were: episodes run without any timer."""
+        for holder, name, own, _, _ in reversed(self._wrapped):
+            if own is _INHERITED:
+                if name in vars(holder):
+                    delattr(holder, name)
+            else:
+                setattr(holder, name, own)
 
     def calibrate(self, n: int = 20000, repeats: int = 5) -> None:
-        """The wrapper's own CPU per call on a no-op (medians of ``repeats``): inside the timed
-        interval (``cost_in``), outside it (``cost_out``), and passing a nested call through."""
-        noop = self.timed(abs, "_calibration")
-        inside, outside, passing = [], [], []
-        for _ in range(repeats):
-            self.acc["_calibration"] = 0.0
-            c0 = time.process_time()
-            for _ in range(n):
-                noop(1)
-            total = time.process_time() - c0
-            c0 = time.process_time()
-            for _ in range(n):
-                abs(1)
-            bare = time.process_time() - c0
-            inside.append(self.acc["_calibration"] / n)
-            outside.append((total - bare) / n - inside[-1])
-            self._depth = 1
-            c0 = time.process_time()
-            for _ in range(n):
-                noop(1)
-            passing.append((time.process_time() - c0 - bare) / n)
-            self._depth = 0
-        self.cost_in, self.cost_out, self.cost_pass = st.median(inside), st.median(outside), st.median(passing)
-        for d in (self.acc, self.calls):
-            d.pop("_calibration", None)
-        self.passed = 0
+        """The wrapper's own CPU per call (medians of ``repeats``), measured on PyBullet's
+        cheapest call made as robocfg calls ``stepSimulation`` (a keyword client id): the part
+        charged to the called label (``cost_in``) and the part charged to the caller's (``cost_out``)."""
+        import pybullet
+
+        client = pybullet.connect(pybullet.DIRECT)
+        f = pybullet.getNumBodies
+        noop = self.timed(f, "_calibration")
+        inside, outside = [], []
+        try:
+            for _ in range(repeats):
+                self.acc["_calibration"] = self.acc["_caller"] = 0.0
+                self._stack.append("_caller")
+                self._mark = time.process_time()
+                for _ in range(n):
+                    noop(physicsClientId=client)
+                self.acc["_caller"] += time.process_time() - self._mark
+                self._stack.pop()
+                c0 = time.process_time()
+                for _ in range(n):
+                    f(physicsClientId=client)
+                c1 = time.process_time()
+                for _ in range(n):
+                    pass
+                loop = (time.process_time() - c1) / n
+                call = (c1 - c0) / n - loop  # the call itself
+                inside.append(self.acc["_calibration"] / n - call)
+                outside.append(self.acc["_caller"] / n - loop)
+        finally:
+            pybullet.disconnect(client)
+        self.cost_in, self.cost_out = st.median(inside), st.median(outside)
+        for d in (self.acc, self.calls, self.inner):
+            for key in ("_calibration", "_caller"):
+                d.pop(key, None)
+        self._mark = time.process_time()
 
     def snapshot(self) -> dict[str, float]:
-        """CPU s per label with the timers' in-interval cost removed, and ``_timers``: the CPU s
-        the timers cost outside their intervals (calls that were timed, and passed through)."""
-        out = {k: v - self.calls[k] * self.cost_in for k, v in self.acc.items()}
-        out["_timers"] = sum(self.calls.values()) * (self.cost_in + self.cost_out) + self.passed * self.cost_pass
+        """CPU s per label with the timers' cost removed from where it fell, and ``_timers``: the
+        CPU s the timers cost (``other`` is charged up to now)."""
+        t = time.process_time()
+        self.acc[self._stack[-1]] += t - self._mark
+        self._mark = t
+        out = {k: v - self.calls[k] * self.cost_in - self.inner[k] * self.cost_out for k, v in self.acc.items()}
+        out["_timers"] = sum(self.calls.values()) * (self.cost_in + self.cost_out)
         return out
 
 
@@ -133,11 +214,14 @@ def _task(name: str):
 
 
 def _episode(session: Any, k: int, meter: Meter) -> tuple[float, dict[str, float]]:
+    """(episode CPU s, {label: CPU s} with ``calls:<label>``: the label's timed calls)."""
+    calls0 = dict(meter.calls)
     before, c0 = meter.snapshot(), time.process_time()
     session.run(k)
     cpu = time.process_time() - c0
     after = meter.snapshot()
-    return cpu, {key: after.get(key, 0.0) - before.get(key, 0.0) for key in after}
+    out = {key: after.get(key, 0.0) - before.get(key, 0.0) for key in after}
+    return cpu, out | {f"calls:{key}": float(n - calls0.get(key, 0)) for key, n in meter.calls.items()}
 
 
 def main() -> None:
@@ -167,6 +251,8 @@ def main() -> None:
     sessions |= {f: open_session(task, RunOptions(seed=0, sink=sinks[f])) for f in formats}
     runs: dict[str, list[tuple[float, dict[str, float]]]] = {k: [] for k in sessions}
     fixed: dict[str, float] = defaultdict(float)
+    untimed: list[float] = []
+    physics_runs: list[tuple[float, dict[str, float]]] = []
     make_writer = sink_module.make_writer
 
     def timed_make_writer(fmt: Any, *a: Any) -> Any:  # the writer's first use: imports, file opened
@@ -180,9 +266,23 @@ def main() -> None:
     try:
         for session in sessions.values():
             session.run(0)
+        meter.uninstall()
         for k in range(1, args.episodes + 1):
-            for key, session in sessions.items():
-                runs[key].append(_episode(session, k, meter))
+            # Episode k three ways, in turn (the order rotates with k): every bucket timed, only
+            # stepSimulation timed (the physics, with the fewest timers), no timer at all (the CPU).
+            for way in (("buckets", "physics", "untimed") * 2)[k % 3:k % 3 + 3]:
+                if way == "untimed":
+                    c0 = time.process_time()
+                    sessions["none"].run(k)
+                    untimed.append(time.process_time() - c0)
+                    continue
+                meter.install(physics_only=way == "physics")
+                if way == "physics":
+                    physics_runs.append(_episode(sessions["none"], k, meter))
+                else:
+                    for key, session in sessions.items():
+                        runs[key].append(_episode(session, k, meter))
+                meter.uninstall()
         for f in formats:
             c0 = time.process_time()
             sinks[f].close()
@@ -196,34 +296,49 @@ def main() -> None:
         return float(st.median(values))
 
     none = runs["none"]
-    physics = med([b.get("stepSimulation", 0.0) for _, b in none])
-    timers = med([b.get("_timers", 0.0) for _, b in none])
-    cpu = med([c - b.get("_timers", 0.0) for c, b in none])  # the episode without the benchmark's timers
-    own = med([(c - b.get("_timers", 0.0) - b.get("stepSimulation", 0.0)) / b.get("stepSimulation", 1.0)
-               for c, b in none])
+
+    def own_of(run: tuple[float, dict[str, float]]) -> float:  # (episode CPU − timers − physics) ÷ physics
+        c, b = run
+        return (c - b["_timers"] - b["stepSimulation"]) / b["stepSimulation"]
+
+    phys = [b["stepSimulation"] for _, b in physics_runs]
+    # The headline: the CPU of the untimed run of episode k minus the physics of its physics-only run.
+    own = med([(u - ph) / ph for u, ph in zip(untimed, phys, strict=True)])
+    physics, cpu = med(phys), med(untimed)
     labels = list(dict.fromkeys(label for *_, label in BUCKETS))
     buckets = {label: med([b.get(label, 0.0) for _, b in none]) for label in labels}
+    calls = {label: med([b.get(f"calls:{label}", 0.0) for _, b in none]) for label in labels}
+    other = med([b.get("other", 0.0) for _, b in none])
+    phys_buckets = med([b["stepSimulation"] for _, b in none])
+
     def net(run: tuple[float, dict[str, float]]) -> float:  # an episode's CPU without the benchmark's timers
         return run[0] - run[1].get("_timers", 0.0)
 
     cost = {f: med([net(d) / net(n) for n, d in zip(none, runs[f], strict=True)]) for f in formats}
     res = {"task": args.task, "episodes": args.episodes, "cpu_per_episode_ms": round(cpu * 1e3, 2),
            "physics_per_episode_ms": round(physics * 1e3, 2), "own_share_of_physics": round(own, 3),
+           "own_share_physics_run": round(med([own_of(r) for r in physics_runs]), 3),
+           "own_share_bucket_run": round(med([own_of(r) for r in none]), 3),
+           "physics_bucket_run_ms": round(phys_buckets * 1e3, 2),
            "buckets_ms": {k: round(v * 1e3, 2) for k, v in buckets.items()},
-           "other_ms": round((cpu - physics - sum(buckets.values())) * 1e3, 2),
-           "timer_overhead_ms": round(timers * 1e3, 2),
-           "timer_cost_us": {"inside": round(meter.cost_in * 1e6, 3), "outside": round(meter.cost_out * 1e6, 3),
-                             "pass_through": round(meter.cost_pass * 1e6, 3)},
+           "calls_per_episode": {k: round(v) for k, v in calls.items()},
+           "other_ms": round(other * 1e3, 2),
+           "timer_overhead_ms": {"physics_run": round(med([b["_timers"] for _, b in physics_runs]) * 1e3, 2),
+                                 "bucket_run": round(med([b["_timers"] for _, b in none]) * 1e3, 2)},
+           "timer_cost_us": {"inside": round(meter.cost_in * 1e6, 3), "outside": round(meter.cost_out * 1e6, 3)},
            "state_only_dataset_cost": {f: round(c, 3) for f, c in cost.items()},
            "dataset_cpu_per_episode_ms": {f: round(med([net(r) for r in runs[f]]) * 1e3, 2) for f in formats},
            "fixed_ms": {f: round(v * 1e3, 1) for f, v in fixed.items()}}
-    print(f"{args.task}: {cpu * 1e3:.1f} ms CPU per episode, {physics * 1e3:.1f} ms in stepSimulation; "
-          f"robocfg's own work {own:.1%} of physics (median over {args.episodes} episodes; the benchmark's "
-          f"timers, {timers * 1e3:.1f} ms an episode at {meter.cost_in * 1e6:.2f} + {meter.cost_out * 1e6:.2f} µs a call, "
-          f"removed)")
+    print(f"{args.task}: {cpu * 1e3:.1f} ms CPU per episode, {physics * 1e3:.1f} ms in stepSimulation; robocfg's own "
+          f"work {own:.1%} of physics (median over episodes 1..{args.episodes} of (untimed CPU − physics) ÷ physics)")
+    print(f"  cross-checks: {res['own_share_physics_run']:.1%} from the physics-only timed run, "
+          f"{res['own_share_bucket_run']:.1%} from the bucketed run (its timers, {res['timer_overhead_ms']['bucket_run']:.1f} ms "
+          f"an episode at {meter.cost_in * 1e6:.2f} + {meter.cost_out * 1e6:.2f} µs a call by calibration, removed; what they "
+          f"cost beyond that in situ stays in its buckets)")
+    print(f"  buckets of the bucketed run (exclusive; physics there {phys_buckets * 1e3:.1f} ms):")
     for label, v in sorted(buckets.items(), key=lambda kv: -kv[1]):
-        print(f"  {label:22s} {v * 1e3:7.2f} ms  {v / physics:6.1%} of physics")
-    print(f"  {'other':22s} {res['other_ms']:7.2f} ms  {res['other_ms'] / 1e3 / physics:6.1%} of physics")
+        print(f"  {label:26s} {v * 1e3:7.2f} ms  {v / phys_buckets:6.1%} of physics  ({calls[label]:.0f} calls)")
+    print(f"  {'other':26s} {other * 1e3:7.2f} ms  {other / phys_buckets:6.1%} of physics")
     for f in formats:
         print(f"state-only {f} dataset: {cost[f]:.3f}x the CPU of the same episode without (median of per-episode "
               f"ratios); once per run: {res['fixed_ms'][f]:.1f} ms (writer opened incl. first imports, and closed)")
