@@ -25,7 +25,8 @@ from robocfg.engine import (
     run_episode,
     runner_for,
 )
-from robocfg.engine.registry import command_name, unregister_task
+from robocfg.engine.registry import builtin_command, command_name, unregister_task
+from robocfg.engine.runner import TaskCommand
 from robocfg.engine.spec import close_cached_session
 
 COMMON_FLAGS = ("--robot", "--arm", "--seed", "--episodes", "--json", "--record", "--record-episode", "--gui",
@@ -41,6 +42,20 @@ def test_registry_and_config_table_agree():
         assert dataclasses.is_dataclass(runner.report)
     with pytest.raises(robocfg.NotFound, match="did you mean 'pick_place'"):
         runner_for("pick_plac")
+
+
+def test_every_builtin_kind_runner_is_its_command_face():
+    """``run KIND --help`` is built from the kind's light ``robocfg.runners.<kind>_command`` class;
+    the runner subclasses it and redefines none of its attributes, so the help, the options and
+    the episode flag the command line offers are the runner's."""
+    for kind, runner in registered().items():
+        command = builtin_command(kind)
+        assert command is not None and command.kind == kind and issubclass(runner, command), kind
+        faces = list(TaskCommand.__annotations__)
+        assert sorted(faces) == ["Options", "description", "episodic", "kind", "summary", "verb"]
+        assert [n for n in faces if n in vars(runner)] == [], kind  # all inherited from the face
+        assert command.episodic == runner.episodic and command.Options is runner.Options, kind
+    assert builtin_command("drop") is None
 
 
 @pytest.mark.parametrize("kind", sorted(TASK_MODELS))

@@ -47,11 +47,16 @@ def test_root_help_imports_no_numpy_pydantic_or_simulator(tmp_path) -> None:
     assert _heavy(names, [*NEVER, "numpy", "pydantic", "scipy", "pybullet", "pinocchio", "rich"]) == []
 
 
-def test_run_kind_help_imports_no_simulator_kinematics_or_scipy(tmp_path) -> None:
-    names = _imported(tmp_path, ["run", "pick-place", "--help"])
-    assert "robocfg.runners.pick_place" in names  # the kind's options come from its runner
-    assert _heavy(names, [*NEVER, "scipy", "pybullet", "pinocchio"]) == []
-    assert [m for m in OTHER_KINDS if m in names] == []  # that kind's runner only
+@pytest.mark.parametrize("kind", ["pick_place", "trajectory", "grasp"])
+def test_run_kind_help_imports_no_episode_code(tmp_path, kind: str) -> None:
+    """``run KIND --help`` reads the kind's command face (help, own options), not its runner: no
+    numpy, config models, session, simulator, kinematics or scipy."""
+    names = _imported(tmp_path, ["run", kind.replace("_", "-"), "--help"])
+    assert f"robocfg.runners.{kind}_command" in names  # the kind's options come from its command face
+    assert _heavy(names, [*NEVER, "numpy", "scipy", "pybullet", "pinocchio"]) == []
+    runners = {f"robocfg.runners.{kind}", *OTHER_KINDS, "robocfg.runners.pick_place"}
+    assert sorted(runners & names) == []
+    assert {"robocfg.engine.session", "robocfg.engine.spec", "robocfg.config.task", "robocfg.checks"} & names == set()
 
 
 def test_run_help_lists_every_kind(tmp_path) -> None:

@@ -1,7 +1,8 @@
 """``robocfg run KIND``: one sub-command per registered task kind, made by one factory
 (``robocfg.cli.run_command``). The kinds load when ``run`` itself is used, so ``robocfg --help``
-and ``robocfg validate`` stay fast; ``robocfg run KIND`` (and its ``--help``) loads that kind's
-runner only, ``robocfg run --help`` (the list) loads them all."""
+and ``robocfg validate`` stay fast; ``robocfg run KIND --help`` loads that built-in kind's command
+face only (``robocfg.runners.<kind>_command``: help and options, no episode code), ``robocfg run
+KIND`` its runner when the command runs, ``robocfg run --help`` (the list) every runner."""
 
 from __future__ import annotations
 
@@ -16,13 +17,13 @@ class _KindsGroup(TyperGroup):
 
     _all_loaded = False
 
-    def _add(self, kind: str, runner: Any) -> Any:
+    def _add(self, kind: str, command: Any) -> Any:
         from robocfg.cli.help_style import polish
         from robocfg.cli.run_command import make_command
         from robocfg.engine.registry import command_name
 
         sub = typer.Typer(add_completion=False, rich_markup_mode=None)
-        fn = make_command(runner)
+        fn = make_command(command)
         sub.command(command_name(kind), help=fn.__doc__)(fn)
         cmd = self.commands[command_name(kind)] = typer.main.get_command(sub)
         polish(cmd)  # loaded after the root polished the tree
@@ -51,11 +52,11 @@ class _KindsGroup(TyperGroup):
 
         if cmd_name in self.commands:
             return self.commands[cmd_name]
-        kind = builtin_kind(cmd_name)  # a built-in kind: its runner alone
+        kind = builtin_kind(cmd_name)  # a built-in kind: its command face alone (the runner loads to run)
         if kind is not None and not self._all_loaded:
-            from robocfg.engine.registry import runner_for
+            from robocfg.engine.registry import command_for
 
-            return self._add(kind, runner_for(kind))
+            return self._add(kind, command_for(kind))
         return self._commands().get(cmd_name)
 
 

@@ -29,7 +29,7 @@ from robocfg.cli.set_option import SetOpt
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
     from robocfg.engine.options import RunOptions
-    from robocfg.engine.runner import TaskRunner
+    from robocfg.engine.runner import TaskCommand, TaskRunner
 
 
 @dataclass
@@ -128,14 +128,18 @@ def _choice(choices: tuple[str, ...], option: str) -> Callable[[str], str]:
     return check
 
 
-def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
-    """The typer command function of a registered kind."""
+def make_command(command: type[TaskCommand]) -> Callable[..., int]:
+    """The typer command function of a registered kind, from its command face (a built-in kind's
+    ``robocfg.runners.<kind>_command`` class, or the runner): the runner loads when it runs."""
     from robocfg.engine.registry import command_name
 
-    command = command_name(runner.kind)
-    params = _common_parameters(runner.kind, command, runner.verb, runner.episodic) + _kind_parameters(runner.Options)
+    name = command_name(command.kind)
+    params = _common_parameters(command.kind, name, command.verb, command.episodic) + _kind_parameters(command.Options)
 
     def run_kind(**kw: Any) -> int:
+        from robocfg.engine.registry import runner_for
+
+        runner = runner_for(command.kind)
         extras = None
         if runner.Options is not None:
             extras = runner.Options(**{k[2:]: kw.pop(k) for k in list(kw) if k.startswith("x_")})
@@ -143,8 +147,8 @@ def make_command(runner: type[TaskRunner]) -> Callable[..., int]:
 
     run_kind.__signature__ = inspect.Signature(params, return_annotation=int)  # type: ignore[attr-defined]
     run_kind.__annotations__ = {p.name: p.annotation for p in params} | {"return": int}
-    run_kind.__doc__ = f"{runner.summary}\n\n{runner.description}" if runner.description else runner.summary
-    run_kind.__name__ = f"run_{runner.kind}"
+    run_kind.__doc__ = f"{command.summary}\n\n{command.description}" if command.description else command.summary
+    run_kind.__name__ = f"run_{command.kind}"
     return run_kind
 
 

@@ -24,28 +24,58 @@ every kind shares), ``spec`` (:class:`EpisodeSpec`, :func:`run_episode`, :func:`
 
 from __future__ import annotations
 
-from typing import Any
+import importlib
+from typing import TYPE_CHECKING, Any
 
-from robocfg.engine.options import EpisodeObserver, RunOptions, option
-from robocfg.engine.registry import register_task, registered, runner_for
-from robocfg.engine.runner import ReportView, RunOutput, TableView, TaskRunner
-from robocfg.engine.session import (
-    BatchTiming,
-    EpisodeSession,
-    EpisodicRunner,
-    Session,
-    episode_rng,
-    run_batch,
-)
-from robocfg.engine.spec import EpisodeSpec, TaskSource, open_session, run_episode
+if TYPE_CHECKING:
+    from robocfg.engine.options import EpisodeObserver, RunOptions, option
+    from robocfg.engine.registry import register_task, registered, runner_for
+    from robocfg.engine.runner import ReportView, RunOutput, TableView, TaskCommand, TaskRunner
+    from robocfg.engine.session import (
+        BatchTiming,
+        EpisodeSession,
+        EpisodicRunner,
+        Session,
+        episode_rng,
+        run_batch,
+    )
+    from robocfg.engine.spec import EpisodeSpec, TaskSource, open_session, run_episode
 
 __all__ = ["BatchTiming", "EpisodeObserver", "EpisodeSession", "EpisodeSpec", "EpisodicRunner", "ReportView",
-           "RunOptions", "RunOutput", "Session", "TableView", "TaskRunner", "TaskSource", "episode_rng", "open_session",
-           "option", "register_task", "registered", "run", "run_batch", "run_episode", "runner_for"]
+           "RunOptions", "RunOutput", "Session", "TableView", "TaskCommand", "TaskRunner", "TaskSource", "episode_rng",
+           "open_session", "option", "register_task", "registered", "run", "run_batch", "run_episode", "runner_for"]
+
+# name → the module that defines it. Loaded on first use (PEP 562), so importing one light module
+# of the package (``robocfg.engine.options``, ``robocfg.engine.dataset``: a kind's command-line
+# options) does not load the registry, every kind's config models and the session machinery — what
+# ``robocfg run KIND --help`` would otherwise pay (≈ 0.1 s).
+_LAZY = {
+    **dict.fromkeys(("EpisodeObserver", "RunOptions", "option"), "options"),
+    **dict.fromkeys(("register_task", "registered", "runner_for"), "registry"),
+    **dict.fromkeys(("ReportView", "RunOutput", "TableView", "TaskCommand", "TaskRunner"), "runner"),
+    **dict.fromkeys(("BatchTiming", "EpisodeSession", "EpisodicRunner", "Session", "episode_rng", "run_batch"),
+                    "session"),
+    **dict.fromkeys(("EpisodeSpec", "TaskSource", "open_session", "run_episode"), "spec"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'robocfg.engine' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"robocfg.engine.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
 
 
 def run(task: Any, options: RunOptions | None = None) -> RunOutput:
     """Run a checked task of any kind; its :class:`RunOutput` (report + timing)."""
+    from robocfg.engine.registry import runner_for
+
     runner = runner_for(task.config.task)(task, options)
     runner.check()
     return runner.run()

@@ -19,8 +19,7 @@ from __future__ import annotations
 import importlib
 from typing import TypeVar
 
-from robocfg.config.task import TASK_MODELS, add_task_kind, params_model
-from robocfg.engine.runner import TaskRunner
+from robocfg.engine.runner import TaskCommand, TaskRunner
 from robocfg.errors import NotFound
 
 _REGISTRY: dict[str, type[TaskRunner]] = {}
@@ -41,6 +40,8 @@ R = TypeVar("R", bound=type[TaskRunner])
 def register_task(cls: R) -> R:
     """Class decorator: register a runner under its ``kind``. A second class for the same kind is
     an error; a kind the config does not declare yet is declared with the runner's ``params``."""
+    from robocfg.config.task import TASK_MODELS, add_task_kind, params_model
+
     kind = cls.kind
     if kind in _REGISTRY and _REGISTRY[kind] is not cls:
         raise ValueError(f"task kind {kind!r} is already registered by {_REGISTRY[kind].__qualname__}")
@@ -86,6 +87,31 @@ def runner_for(kind: str) -> type[TaskRunner]:
     if kind not in _REGISTRY:
         raise NotFound("task kind", kind, list(_REGISTRY))
     return _REGISTRY[kind]
+
+
+def command_for(kind: str) -> type[TaskCommand]:
+    """What ``robocfg run KIND`` shows and parses before running (its help, own options, whether
+    it has episodes): a built-in kind not loaded yet gives its :func:`builtin_command`, so
+    ``--help`` loads no episode code; any other kind gives its runner."""
+    if kind not in _REGISTRY:
+        command = builtin_command(kind)
+        if command is not None:
+            return command
+    return runner_for(kind)
+
+
+def builtin_command(kind: str) -> type[TaskCommand] | None:
+    """The command face of a built-in kind: class ``<Kind>Command`` of the light module
+    ``robocfg.runners.<kind>_command``, which the kind's runner subclasses (a test checks every
+    built-in kind); None for any other kind."""
+    module = _BUILTIN_KINDS.get(kind)
+    if module is None:
+        return None
+    name = "".join(w.capitalize() for w in kind.split("_")) + "Command"
+    command = getattr(importlib.import_module(f"{module}_command"), name)
+    if not (isinstance(command, type) and issubclass(command, TaskCommand) and command.kind == kind):
+        raise TypeError(f"{module}_command.{name} is not the TaskCommand of kind {kind!r}")
+    return command
 
 
 def registered() -> dict[str, type[TaskRunner]]:

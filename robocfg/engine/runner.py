@@ -130,17 +130,26 @@ def check_arm_option(robot: RobotConfig, arm: str | None) -> None:
     raise ConfigError([Problem(f"--arm {arm}", None, None, "", message)])
 
 
-class TaskRunner(ABC):
-    """Base of every task kind's runner; subclasses set the class attributes and ``run``."""
+class TaskCommand:
+    """What the command line shows of a kind before anything runs: its name, help, own options
+    and whether it has episodes (``robocfg run KIND --help`` and the option parsing need no more).
+    Every runner is one; a built-in kind also declares its own in a light module
+    (``robocfg.runners.<kind>_command``) that its runner subclasses, so ``--help`` loads no
+    episode code (``robocfg.engine.registry.command_for``)."""
 
     kind: ClassVar[str]  # the YAML's `task:` value; `robocfg run <kind with - for _>`
-    params: ClassVar[type]  # model of the YAML's `<kind>:` block
-    report: ClassVar[type]  # report dataclass (its JSON Schema: `robocfg schema report-<kind>`)
     Options: ClassVar[type | None] = None  # the kind's own options (a dataclass of option(...) fields)
     summary: ClassVar[str] = ""  # one line: the command's short help
     description: ClassVar[str] = ""  # the command's help text
     verb: ClassVar[str] = "succeeded"  # progress bar: "3 placed"
     episodic: ClassVar[bool] = False  # runs several seeded episodes (--episodes > 1)
+
+
+class TaskRunner(TaskCommand, ABC):
+    """Base of every task kind's runner; subclasses set the class attributes and ``run``."""
+
+    params: ClassVar[type]  # model of the YAML's `<kind>:` block
+    report: ClassVar[type]  # report dataclass (its JSON Schema: `robocfg schema report-<kind>`)
 
     def __init__(self, task: CheckedTask, options: RunOptions | None = None):
         self.task = task

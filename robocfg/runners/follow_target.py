@@ -16,7 +16,6 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -24,12 +23,13 @@ import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import FollowTargetParams, Motion
-from robocfg.engine.dataset import DatasetOptions, EpisodeSink, ReplayScene
-from robocfg.engine.options import RunOptions, option
+from robocfg.engine.dataset import EpisodeSink, ReplayScene
+from robocfg.engine.options import RunOptions
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import RunOutput, TaskRunner
 from robocfg.errors import RunFailed
 from robocfg.geometry import euler_deg_to_quat_xyzw, quat_to_matrix
+from robocfg.runners.follow_target_command import FollowTargetCommand, FollowTargetOptions
 from robocfg.runners.follow_target_loop import FollowLoop
 from robocfg.runners.follow_target_report import FINAL_WINDOW, FollowTargetResult, Stats
 
@@ -39,32 +39,10 @@ if TYPE_CHECKING:
 __all__ = ["FollowTargetResult", "FollowTargetRunner", "Stats", "run_follow_target"]
 
 
-
-@dataclass(frozen=True)
-class FollowTargetOptions(DatasetOptions):
-    """``run follow-target``'s own options (and the ``--dataset*`` ones: the run is episode 0)."""
-
-    with_obstacle: bool | None = field(default=None, metadata=option(
-        "--with-obstacle/--without-obstacle",
-        help="Add the task's follow_target.obstacles (default: the task's with_obstacle)."))
-    plot: Path | None = field(default=None, metadata=option(
-        "--plot", output=(".png",), help="Save a plot (.png) of tracking error and clearance against time."))
-
-
 @register_task
-class FollowTargetRunner(TaskRunner):
-    kind = "follow_target"
+class FollowTargetRunner(FollowTargetCommand, TaskRunner):
     params = FollowTargetParams
     report = FollowTargetResult
-    Options = FollowTargetOptions
-    summary = ("Follow a moving target with the TCP, clear of obstacles. A static / waypoint / circle / figure-8 "
-               "target tracked with a QP per control step (placo), keeping the safety margin from obstacles, "
-               "table and ground. With --gui, drag the target with the sliders.")
-    description = (
-        "With --dataset the run is recorded as one episode at --dataset-fps: observations, the controller's "
-        "commanded joint positions as actions (sent one frame ahead along its joint velocity, for the frame the "
-        "recording's command gate delays them), success = the target was reached; `robocfg dataset replay` "
-        "re-simulates it from those actions with the same target and obstacle motions.")
 
     def check(self) -> None:
         super().check()

@@ -8,20 +8,20 @@ before each episode (the gripper's box model is measured once, before the snapsh
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from robocfg.config.commands import GraspParams, Limits
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.datasets.language import grasp_instruction
-from robocfg.engine.dataset import DatasetOptions, ReplayScene
-from robocfg.engine.options import FrameRecorder, RunOptions, option
+from robocfg.engine.dataset import ReplayScene
+from robocfg.engine.options import FrameRecorder, RunOptions
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.errors import ConfigError, Problem, RobocfgError
 from robocfg.motion.moves import bound_ik_by_iterations
+from robocfg.runners.grasp_command import GraspCommand, GraspOptions
 from robocfg.runners.grasp_episode import EpisodeFailed, EpisodeSetup, _Context, _Episode
 from robocfg.runners.grasp_report import GraspEpisode, GraspReport, GraspTiming, summarise
 
@@ -36,14 +36,6 @@ def episode_setup(params: GraspParams, seed: int, k: int) -> EpisodeSetup:
 
 def episode_setups(params: GraspParams, seed: int, episodes: int) -> list[EpisodeSetup]:
     return [episode_setup(params, seed, k) for k in range(episodes)]
-
-
-@dataclass(frozen=True)
-class GraspOptions(DatasetOptions):
-    """``run grasp``'s own options (and the ``--dataset*`` ones)."""
-
-    save_cloud: Path | None = field(default=None, metadata=option(
-        "--save-cloud", output=(".npz", ".ply"), help="Write the first object cloud (.npz or .ply)."))
 
 
 class GraspSession(EpisodeSession[GraspEpisode]):
@@ -135,19 +127,9 @@ def _cloud_saver(path: Path) -> Callable[[Any], None]:
 
 
 @register_task
-class GraspRunner(EpisodicRunner):
-    kind = "grasp"
+class GraspRunner(GraspCommand, EpisodicRunner):
     params = GraspParams
     report = GraspReport
-    Options = GraspOptions
-    verb = "lifted"
-    summary = ("Grasp objects, planning from simulated depth cameras. Perceive the object with RGB-D "
-               "cameras, plan antipodal grasps on the point cloud, execute the best, lift, shake and verify; "
-               "retry the next-ranked grasp on failure.")
-    description = (
-        "Grasp → EE by R_ee_graspnet, ee_axis, tcp_offset. Episode k grasps objects[k % n]. Exit 0 when the "
-        "lift success rate reaches --min-success, 1 otherwise (no object points in the workspace, no feasible "
-        "grasp, or the object was not held). --record draws the candidate grasps.")
 
     def check(self) -> None:
         super().check()

@@ -20,6 +20,7 @@ from robocfg.config.robot import ParallelGripperConfig
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import RunOutput, TaskRunner
 from robocfg.errors import RobocfgError, RunFailed, RunInterrupted
+from robocfg.runners.gripper_command import GripperCommand
 from robocfg.runners.gripper_hold import hold_test, suction_test
 from robocfg.runners.gripper_report import GripperResult, HoldTest, Move
 from robocfg.runners.gripper_run import SETTLE_TIME, GripperRun
@@ -30,12 +31,9 @@ WIDTH_CHANGE_MIN = 0.8  # fraction of (max_width − min_width) a free close/ope
 
 
 @register_task
-class GripperRunner(TaskRunner):
-    kind = "gripper"
+class GripperRunner(GripperCommand, TaskRunner):
     params = GripperParams
     report = GripperResult
-    summary = ("Close and open the gripper, then hold a cube. Reports measured widths, timing, mimic error and "
-               "the hold test.")
 
     def check(self) -> None:
         super().check()

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -17,12 +16,13 @@ import numpy as np
 from robocfg.config.commands import Limits, PickPlaceParams
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.datasets.language import pick_place_instruction
-from robocfg.engine.dataset import DatasetOptions, ReplayScene
+from robocfg.engine.dataset import ReplayScene
 from robocfg.engine.options import FrameRecorder, RunOptions
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import BatchTiming, EpisodeSession, EpisodicRunner, episode_rng
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
+from robocfg.runners.pick_place_command import PickPlaceCommand
 from robocfg.runners.pick_place_machine import _StateMachine
 from robocfg.runners.pick_place_report import EpisodeResult, PickPlaceReport, summarise
 from robocfg.runners.pick_place_setup import (
@@ -62,11 +62,6 @@ def episode_setup(params: PickPlaceParams, seed: int, k: int) -> EpisodeSetup:
 def episode_setups(params: PickPlaceParams, seed: int, episodes: int) -> list[EpisodeSetup]:
     """The setups of episodes 0 .. ``episodes`` − 1."""
     return [episode_setup(params, seed, k) for k in range(episodes)]
-
-
-@dataclass(frozen=True)
-class PickPlaceOptions(DatasetOptions):
-    """``run pick-place``'s own options: recording a dataset (the CLI builds the sink from them)."""
 
 
 class PickPlaceSession(EpisodeSession[EpisodeResult]):
@@ -158,21 +153,9 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
 
 
 @register_task
-class PickPlaceRunner(EpisodicRunner):
-    kind = "pick_place"
+class PickPlaceRunner(PickPlaceCommand, EpisodicRunner):
     params = PickPlaceParams
     report = PickPlaceReport
-    Options = PickPlaceOptions
-    verb = "placed"
-    summary = ("Pick the task's object and place it, on any robot. Grasp → EE by R_ee_graspnet, ee_axis, "
-               "tcp_offset.")
-    description = (
-        "Exit 0 when the success rate reaches --min-success (default: every episode), 1 otherwise; the "
-        "--json report (one record per episode; no wall-clock figures, so the same seed gives the same "
-        "file) is written either way. With --dataset every episode is recorded at --dataset-fps "
-        "(observations, the joint-target + gripper actions that drove the robot, phase labels, images of "
-        "the task's cameras) and the kept ones are written as a LeRobot v3.0 or robomimic HDF5 dataset; "
-        "`robocfg dataset replay` re-simulates an episode from those actions.")
 
     @classmethod
     def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:

@@ -26,13 +26,14 @@ from robocfg.config.commands import Limits, PickPlaceParams, PickPlaceRandomize,
 from robocfg.config.multi_pick import PickObject, PickPlaceManyParams
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.config.scene import Body
-from robocfg.engine.dataset import DatasetOptions, ReplayScene
+from robocfg.engine.dataset import ReplayScene
 from robocfg.engine.options import FrameRecorder
 from robocfg.engine.randomize import place_randomly
 from robocfg.engine.registry import register_task
 from robocfg.engine.session import EpisodeSession, EpisodicRunner
 from robocfg.errors import ConfigError, Problem
 from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
+from robocfg.runners.pick_place_many_command import PickPlaceManyCommand
 from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch, ObjectMachine, Spot
 from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
 from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
@@ -77,11 +78,6 @@ def spot_points(task, params: PickPlaceManyParams) -> np.ndarray:
 
     radius = max(footprint_radius(o, task.path.parent) for o in params.objects)
     return place_spots(task.config.scene, params.place, radius).points[: len(params.objects)]
-
-
-@dataclass(frozen=True)
-class PickPlaceManyOptions(DatasetOptions):
-    """``run pick-place-many``'s own options: recording a dataset (the CLI builds the sink)."""
 
 
 class ManySession(EpisodeSession[ManyEpisode]):
@@ -255,20 +251,9 @@ class ManySession(EpisodeSession[ManyEpisode]):
 
 
 @register_task
-class PickPlaceManyRunner(EpisodicRunner):
-    kind = "pick_place_many"
+class PickPlaceManyRunner(PickPlaceManyCommand, EpisodicRunner):
     params = PickPlaceManyParams
     report = ManyReport
-    Options = PickPlaceManyOptions
-    verb = "cleared"
-    summary = "Pick objects in turn into a bin or onto a shelf."
-    description = (
-        "Each episode randomises every object in its own region, then picks them one at a time (listed order, or "
-        "by reachability) with grasps filtered for collisions of the whole arm and gripper with the neighbours and "
-        "fixtures, and places them on spots spaced so they do not land on each other. Exit 0 when the share of "
-        "episodes with every object placed reaches --min-success; failures name the object and the phase. With "
-        "--dataset every episode is recorded as for pick-place, the environment state holding every object's pose "
-        "in the task's order; `robocfg dataset replay` re-simulates an episode from its actions.")
 
     def check(self) -> None:
         super().check()

@@ -13,41 +13,27 @@ from __future__ import annotations
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
 from robocfg.checks.task import CheckedTask
 from robocfg.config.commands import TrajectoryParams
-from robocfg.engine.dataset import DatasetOptions, EpisodeSink, ReplayScene
-from robocfg.engine.options import option
+from robocfg.engine.dataset import EpisodeSink, ReplayScene
 from robocfg.engine.registry import register_task
 from robocfg.engine.runner import RunOutput, TaskRunner
 from robocfg.errors import ConfigError, Problem, RobocfgError, RunFailed, RunInterrupted
+from robocfg.runners.trajectory_command import TrajectoryCommand, TrajectoryOptions
 from robocfg.runners.trajectory_report import Samples, TrajectoryResult, plot_result
 
 CHECK_RATE = 1000.0  # Hz: resampling rate of the limit check
 
 
-@dataclass(frozen=True)
-class TrajectoryOptions(DatasetOptions):
-    """``run trajectory``'s own options (and the ``--dataset*`` ones: the run is episode 0)."""
-
-    plot: Path | None = field(default=None, metadata=option(
-        "--plot", output=(".png",), help="Write a PNG of q, q̇, q̈ per joint against time (limits dashed)."))
-    no_sim: bool = field(default=False, metadata=option("--no-sim", help="Plan and check only; do not simulate."))
-
-
 @register_task
-class TrajectoryRunner(TaskRunner):
-    kind = "trajectory"
+class TrajectoryRunner(TrajectoryCommand, TaskRunner):
     params = TrajectoryParams
     report = TrajectoryResult
-    Options = TrajectoryOptions
-    summary = ("Plan a time-optimal trajectory and track it. toppra; trapezoids "
-               "with stop_at_waypoints; ruckig with a jerk limit; checked against the limits at 1 kHz, tracked "
-               "in PyBullet. Prints duration, planning time, violations and tracking error.")
 
     def check(self) -> None:
         super().check()

@@ -1,0 +1,29 @@
+"""``run pick-place-many`` before anything runs: its help text and own options
+(``robocfg run pick-place-many --help`` loads this module, not the episode code)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from robocfg.engine.dataset import DatasetOptions
+from robocfg.engine.runner import TaskCommand
+
+
+@dataclass(frozen=True)
+class PickPlaceManyOptions(DatasetOptions):
+    """``run pick-place-many``'s own options: recording a dataset (the CLI builds the sink)."""
+
+
+class PickPlaceManyCommand(TaskCommand):
+    kind = "pick_place_many"
+    Options = PickPlaceManyOptions
+    verb = "cleared"
+    summary = "Pick objects in turn into a bin or onto a shelf."
+    description = (
+        "Each episode randomises every object in its own region, then picks them one at a time (listed order, or "
+        "by reachability) with grasps filtered for collisions of the whole arm and gripper with the neighbours and "
+        "fixtures, and places them on spots spaced so they do not land on each other. Exit 0 when the share of "
+        "episodes with every object placed reaches --min-success; failures name the object and the phase. With "
+        "--dataset every episode is recorded as for pick-place, the environment state holding every object's pose "
+        "in the task's order; `robocfg dataset replay` re-simulates an episode from its actions.")
+    episodic = True
