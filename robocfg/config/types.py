@@ -7,6 +7,10 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
+from robocfg.config.pydantic_plugins import skip_empty_plugin_scan
+
+skip_empty_plugin_scan()  # before the first validator is built (pydantic's plugin scan: robocfg.config.pydantic_plugins)
+
 Axis = Literal["x", "y", "z"]
 AXIS_INDEX: dict[str, int] = {"x": 0, "y": 1, "z": 2}
 
