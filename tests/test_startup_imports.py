@@ -50,10 +50,11 @@ def test_root_help_imports_no_numpy_pydantic_or_simulator(tmp_path) -> None:
 @pytest.mark.parametrize("kind", ["pick_place", "trajectory", "grasp"])
 def test_run_kind_help_imports_no_episode_code(tmp_path, kind: str) -> None:
     """``run KIND --help`` reads the kind's command face (help, own options), not its runner: no
-    numpy, config models, session, simulator, kinematics or scipy."""
+    numpy, config models, session, simulator, kinematics or scipy; and no pydantic (typer's
+    adapters for the flags passed by: robocfg.cli.flags)."""
     names = _imported(tmp_path, ["run", kind.replace("_", "-"), "--help"])
     assert f"robocfg.runners.{kind}_command" in names  # the kind's options come from its command face
-    assert _heavy(names, [*NEVER, "numpy", "scipy", "pybullet", "pinocchio"]) == []
+    assert _heavy(names, [*NEVER, "numpy", "pydantic", "scipy", "pybullet", "pinocchio"]) == []
     runners = {f"robocfg.runners.{kind}", *OTHER_KINDS, "robocfg.runners.pick_place"}
     assert sorted(runners & names) == []
     assert {"robocfg.engine.session", "robocfg.engine.spec", "robocfg.config.task", "robocfg.checks"} & names == set()

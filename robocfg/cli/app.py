@@ -25,13 +25,19 @@ from robocfg.cli import (
 
 class _RootGroup(typer.core.TyperGroup):
     """The ``robocfg`` group: once typer has built the whole command tree, every command's help
-    gets readable placeholders and whole summaries (``robocfg.cli.help_style``)."""
+    gets readable placeholders and whole summaries (``robocfg.cli.help_style``); its flags left
+    off read ``False`` (``robocfg.cli.flags``)."""
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         from robocfg.cli.help_style import polish
 
         polish(self)
+
+    def get_params(self, ctx):
+        from robocfg.cli.flags import off_by_default
+
+        return [off_by_default(p) for p in super().get_params(ctx)]  # --help, --install-completion...
 
 
 app = typer.Typer(

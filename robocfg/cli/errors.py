@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-from robocfg.config.overrides import OVERRIDE_SOURCE, ROBOT_OVERRIDE_SOURCE
 from robocfg.errors import ConfigError, NotFound, Problem, RobocfgError, RunFailed
 
 EXIT_OK, EXIT_RUN_FAILED, EXIT_INVALID = 0, 1, 2
 
-# Problems in what was typed on the command line are named after the option that carried it.
-_OPTION_OF_SOURCE = {OVERRIDE_SOURCE: "--set", ROBOT_OVERRIDE_SOURCE: "--robot"}
 COMMAND_LINE = "<command line>"  # a problem's "file" when its ``path`` is the option itself
 
 
@@ -30,9 +27,13 @@ def describe(exc: BaseException) -> tuple[int, str]:
 def format_problem(problem: Problem) -> str:
     """``FILE:LINE:COL: field: message``; a problem in a command-line value reads
     ``--set pick_place.lift_height: message`` or ``--robot pnda: message``."""
+    # here, not at import: the YAML loader stays unloaded for --help (cli.app imports this module)
+    from robocfg.config.overrides import OVERRIDE_SOURCE, ROBOT_OVERRIDE_SOURCE
+
     if problem.file == COMMAND_LINE and problem.path:
         return f"{problem.path}: {'' if problem.severity == 'error' else 'warning: '}{problem.message}"
-    option = _OPTION_OF_SOURCE.get(problem.file)
+    # problems in what was typed on the command line are named after the option that carried it
+    option = {OVERRIDE_SOURCE: "--set", ROBOT_OVERRIDE_SOURCE: "--robot"}.get(problem.file)
     if option is None or problem.line is not None:
         return problem.format()
     prefix = "" if problem.severity == "error" else "warning: "

@@ -17,6 +17,11 @@ class _KindsGroup(TyperGroup):
 
     _all_loaded = False
 
+    def get_params(self, ctx: Any) -> Any:
+        from robocfg.cli.flags import off_by_default
+
+        return [off_by_default(p) for p in super().get_params(ctx)]  # --help
+
     def _add(self, kind: str, command: Any) -> Any:
         from robocfg.cli.help_style import polish
         from robocfg.cli.run_command import make_command
