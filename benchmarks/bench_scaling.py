@@ -20,7 +20,20 @@ What a run measures, each part apart:
   imports, unpickling; a pool worker forks from a fork server that has imported robocfg, a Ray
   actor is a fresh interpreter) and *build* (world, kinematic model, controllers), medians over
   the workers;
-* *steady*: the episodes on those workers, ``episodes / run s``;
+* *steady*: the episodes on those workers, ``episodes / run s``; *run s* is ``run()`` from its
+  call to its return on the started workers — handing the batches out, the episodes, collecting
+  the results, the run's report (made by one worker from every record) and stopping the workers —
+  plus, with ``--dataset``, merging the shards;
+* *where the workers' time went* (``workers × run s`` split, from wall-clock stamps each batch
+  carries from its worker, ``BatchDone.wall``): inside episodes; *lead* (``run()`` called → the
+  worker's first batch begins); inside batches outside episodes; *gaps* between one batch's end and
+  the next one's start on a worker (the executor's round trip per batch); *imbalance* (a worker idle
+  after its last batch while others finish: the tail); *end* (the last batch → ``run()`` returned:
+  report, stop). *Had core*: CPU ÷ wall inside episodes (< 100 %: the worker waited for a core);
+* efficiency and Ray ÷ pool as products of three factors (each a median over the rounds):
+  *cpu* (CPU per episode: cores that run slower when all are busy, shared caches), *core* (the
+  share of episode time a worker had a core: other processes on the cores) and *busy* (the share
+  of worker-seconds spent in episodes: lead, gaps, tail, end);
 * *CPU per episode*, robust to a host's load because waiting for a core costs no CPU time:
   ``episode ms`` — the worker process's CPU time over one episode (every thread), median over
   every episode of every round (``1st ms``: each worker's first episode, which pays what the
@@ -42,6 +55,7 @@ pool with its (from the median starts and steady rates). The first row (unless
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import os
@@ -72,6 +86,7 @@ class Sample:
     others_cpu: float = float("nan")  # driver + every other process it started, during the run
     first_cpu: float = float("nan")  # median over workers: CPU of each worker's first episode
     niceness: list[int] = field(default_factory=list)  # the workers' scheduling niceness
+    time_line: TimeLine | None = None  # where the run's worker-seconds went
 
     @property
     def eps(self) -> float:
@@ -84,6 +99,50 @@ class Sample:
     @property
     def cpu_per_episode(self) -> float:
         return (self.worker_cpu + self.others_cpu) / self.episodes
+
+
+@dataclass(frozen=True)
+class TimeLine:
+    """Where a run's ``workers × run s`` worker-seconds went (s, summed over the workers), from the
+    wall-clock stamps each batch carries (``BatchDone.wall``, taken in the worker) and the driver's
+    own around ``run()``: ``lead`` — run called → the worker's first batch begins (handing out,
+    the first call's delivery, anything the worker does before its first batch); ``episodes`` —
+    inside episodes (``EpisodeRun.wall``); ``batch`` — inside batches, outside episodes (a shard's
+    opening and closing, the result's assembly); ``gaps`` — between one batch's end and the next
+    one's start on the same worker (returning a result, receiving the next batch: an executor's
+    round trip); ``imbalance`` — the worker's last batch end → the last batch end of all (the
+    tail: idle while others finish); ``end`` — the last batch end of all → ``run()`` returned
+    (the report, made by one worker from every record, and stopping the workers), counted for
+    every worker. ``episode_cpu``: CPU inside the episodes (s): ÷ ``episodes`` is the share of
+    the episodes' wall time the workers had a core."""
+
+    lead: float
+    episodes: float
+    batch: float
+    gaps: float
+    imbalance: float
+    end: float
+    episode_cpu: float
+    n_gaps: int = 0  # how many gaps ``gaps`` sums
+
+    @classmethod
+    def of(cls, done: list, called: float, returned: float, workers: int) -> TimeLine:
+        by_worker: dict[int, list] = {}
+        for b in sorted(done, key=lambda b: b.wall[0]):
+            by_worker.setdefault(b.pid, []).append(b)
+        last = max(bs[-1].wall[1] for bs in by_worker.values())
+        episodes = sum(r.wall for b in done for r in b.runs)
+        spans = sum(b.wall[1] - b.wall[0] for b in done)
+        return cls(lead=sum(bs[0].wall[0] - called for bs in by_worker.values()),
+                   episodes=episodes, batch=spans - episodes,
+                   gaps=sum(n.wall[0] - p.wall[1] for bs in by_worker.values() for p, n in itertools.pairwise(bs)),
+                   n_gaps=sum(len(bs) - 1 for bs in by_worker.values()),
+                   imbalance=sum(last - bs[-1].wall[1] for bs in by_worker.values()),
+                   end=workers * (returned - last), episode_cpu=sum(r.cpu for b in done for r in b.runs))
+
+    @property
+    def total(self) -> float:
+        return self.lead + self.episodes + self.batch + self.gaps + self.imbalance + self.end
 
 
 def _task_without_cameras(tmp: Path) -> Path:
@@ -171,7 +230,9 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
     t1 = time.perf_counter()
     pids = {s.pid for s in pool.starts}
     before = tree.snapshot(pids)
+    called = time.time()
     out = pool.run(recipe, plan_batches(episodes, workers, target is not None))
+    returned = time.time()
     if target is not None:
         MergedShards(out.shards, target.root, target.fmt, target.extra_info).close()
     t2 = time.perf_counter()
@@ -193,7 +254,9 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
                   statistics.median(s.ready - s.opening for s in pool.starts),
                   [r.cpu for r in runs], [r.thread_cpu for r in runs],
                   sum(last[p] - first[p] for p in first), tree.between(before, after),
-                  statistics.median(firsts.values()), [s.niceness for s in pool.starts])
+                  statistics.median(firsts.values()), [s.niceness for s in pool.starts],
+                  TimeLine.of(out.done, called, returned, len(pool.starts))
+                  if all(hasattr(b, "wall") for b in out.done) else None)  # older robocfg: no stamps
 
 
 def start_costs(task) -> tuple[float, float, float]:
@@ -337,7 +400,76 @@ def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
     if any(p["ray_over_pool"] for p in paired):
         print("(ray/pool episode cpu: Ray's median CPU per episode ÷ the pool's, > 1 = Ray's episodes cost more;"
               " ray/pool cpu/ep: the pool's machine CPU per episode ÷ Ray's, < 1 = Ray costs more in all)")
-    return {"rows": table, "paired": paired}
+    return {"rows": table, "paired": paired, **where_time_goes(samples, counts, rounds)}
+
+
+def _factors(a: Sample, b: Sample) -> tuple[float, float, float] | None:
+    """Throughput per worker of ``a`` ÷ that of ``b`` as the product of three factors: episode CPU
+    (``b``'s CPU per episode ÷ ``a``'s: > 1 = ``a``'s episodes cost less CPU), core share
+    (``a``'s episode CPU ÷ episode wall over ``b``'s: < 1 = ``a``'s workers waited longer for a
+    core mid-episode) and busy share (``a``'s episode wall ÷ its worker-seconds over ``b``'s: < 1 =
+    ``a``'s workers sat longer outside episodes: lead, gaps, tail, end). Their product is
+    (``a``.eps / ``a``.workers) ÷ (``b``.eps / ``b``.workers) exactly."""
+    ta, tb = a.time_line, b.time_line
+    if ta is None or tb is None or min(ta.episode_cpu, tb.episode_cpu, ta.total, tb.total) <= 0:
+        return None
+    cpu = (tb.episode_cpu / b.episodes) / (ta.episode_cpu / a.episodes)
+    core = (ta.episode_cpu / ta.episodes) / (tb.episode_cpu / tb.episodes)
+    busy = (ta.episodes / ta.total) / (tb.episodes / tb.total)
+    return cpu, core, busy
+
+
+def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> dict:
+    """Print where each run's worker-seconds went (:class:`TimeLine`) and the efficiency and Ray ÷
+    pool split into factors (:func:`_factors`); return both as JSON-ready data."""
+    print("\nWhere the workers' time went (% of workers × run s; medians over the rounds):")
+    print(f"{'executor':<9}{'w':>3}{'run s':>7}{'episodes':>9}{'had core':>9}{'lead':>7}{'batch':>7}{'gaps':>7}"
+          f"{'ms/gap':>7}{'imbal.':>7}{'end':>7}{'end ms':>7}")
+    rows = []
+    for kind in ("pool", "ray"):
+        for w in counts:
+            runs = [s for s in samples if s.executor == kind and s.workers == w and s.time_line is not None]
+            if not runs:
+                continue
+            tl = [s.time_line for s in runs]
+            share = {k: [100 * getattr(t, k) / t.total for t in tl if t is not None]
+                     for k in ("episodes", "lead", "batch", "gaps", "imbalance", "end")}
+            had_core = [100 * t.episode_cpu / t.episodes for t in tl if t is not None]
+            ms_gap = [1e3 * t.gaps / t.n_gaps for t in tl if t is not None and t.n_gaps]
+            end_ms = [1e3 * t.end / w for t in tl if t is not None]
+            print(f"{kind:<9}{w:>3}{_med([s.run_s for s in runs]):>7.2f}{_med(share['episodes']):>9.1f}"
+                  f"{_med(had_core):>9.1f}{_med(share['lead']):>7.1f}{_med(share['batch']):>7.1f}{_med(share['gaps']):>7.1f}"
+                  f"{_med(ms_gap):>7.2f}{_med(share['imbalance']):>7.1f}{_med(share['end']):>7.1f}{_med(end_ms):>7.0f}")
+            rows.append({"executor": kind, "workers": w, "percent": share, "had_core_percent": had_core,
+                         "ms_per_gap": ms_gap, "end_ms": end_ms})
+    print("(episodes: inside episodes; had core: episode CPU ÷ episode wall; lead: run() called → first batch;"
+          " batch: in batches outside episodes; gaps: between batches (ms/gap: per gap, ≈ per episode without a"
+          " dataset); imbal.: idle after its last batch while others finish; end: the last batch → run() returned"
+          " (report, stopping workers), end ms: its length)")
+    by = {(s.executor, s.workers, s.round): s for s in samples}
+    print(f"\n{'workers':>7}  {'pool efficiency = cpu × core × busy':<44}{'ray/pool steady = cpu × core × busy':<44}")
+    factors = []
+    for w in counts:
+        eff, vs = [], []
+        for r in range(rounds):
+            p, p1, y = by.get(("pool", w, r)), by.get(("pool", 1, r)), by.get(("ray", w, r))
+            if p is not None and p1 is not None and (f := _factors(p, p1)) is not None:
+                eff.append(f)
+            if p is not None and y is not None and (f := _factors(y, p)) is not None:
+                vs.append(f)
+
+        def cols(fs: list[tuple[float, float, float]]) -> str:
+            if not fs:
+                return "-"
+            return (f"{_med([a * b * c for a, b, c in fs]):.2f} = {_med([f[0] for f in fs]):.2f} × "
+                    f"{_med([f[1] for f in fs]):.2f} × {_med([f[2] for f in fs]):.2f}")
+
+        print(f"{w:>7}  {cols(eff):<44}{cols(vs):<44}")
+        factors.append({"workers": w, "pool_efficiency_factors": eff, "ray_over_pool_factors": vs})
+    print("(medians over the rounds of each factor; cpu: episode CPU of the reference ÷ this one's (< 1: episodes"
+          " cost more CPU — slower cores when all are busy, shared caches); core: share of episode wall with a core,"
+          " relative; busy: share of worker-seconds inside episodes, relative (< 1: more idle — lead, gaps, tail, end))")
+    return {"time_line": rows, "factors": factors}
 
 
 def main() -> None:

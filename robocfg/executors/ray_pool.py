@@ -22,6 +22,7 @@ in the environment of ``ray start`` gives the same; ``docs/scale-out.md``).
 
 from __future__ import annotations
 
+import importlib
 import logging
 import os
 import time
@@ -52,6 +53,8 @@ class _Actor:
 
     def __init__(self, recipe: Recipe):
         opening = time.time()
+        for module in recipe.preload:  # what a pool's fork server imports: here, in the actor's start
+            importlib.import_module(module)
         self.recipe = recipe
         self.session = recipe.open()
         self.start = worker_start(opening)

@@ -22,7 +22,10 @@ if TYPE_CHECKING:
     from robocfg.engine import RunOptions, TaskSource
 
 # What every worker needs whatever the kind: imported once by a process pool's fork server.
-COMMON_PRELOAD = ("robocfg.sim.world", "robocfg.engine", "robocfg.kinematics.model", "robocfg.datasets.shards")
+COMMON_PRELOAD = ("robocfg.sim.world", "robocfg.engine", "robocfg.kinematics.model")
+# What a worker needs to write shards: only when the run records a dataset (it imports
+# scipy.spatial, pyarrow's writers...: 0.5 s on the 2-core laptop that a run without one never uses).
+DATASET_PRELOAD = ("robocfg.datasets.shards",)
 
 
 @dataclass(frozen=True)
@@ -49,7 +52,9 @@ class EngineRecipe:
 
     @property
     def preload(self) -> tuple[str, ...]:
-        return (*COMMON_PRELOAD, self.runner_module) if self.runner_module else COMMON_PRELOAD
+        dataset = DATASET_PRELOAD if self.dataset is not None else ()
+        runner = (self.runner_module,) if self.runner_module else ()
+        return (*COMMON_PRELOAD, *dataset, *runner)
 
     def open(self) -> EngineSession:
         return EngineSession(self)

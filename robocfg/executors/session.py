@@ -123,13 +123,16 @@ class Batch:
 class BatchDone:
     """A committed batch: its episodes' runs in index order and the shard they were recorded to;
     ``pid``: the worker process that ran it, ``cpu``: that process's CPU time (s, all threads) when
-    the batch began and when it ended (a benchmark sums a worker's CPU between batches from them)."""
+    the batch began and when it ended (a benchmark sums a worker's CPU between batches from them);
+    ``wall``: the wall clock (s since the epoch) when it began and ended in the worker (a
+    benchmark places the batches on one time line with the driver's: the gaps between them)."""
 
     batch: Batch
     runs: list[EpisodeRun]
     shard: Shard | None
     pid: int = 0
     cpu: tuple[float, float] = (0.0, 0.0)
+    wall: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -187,13 +190,15 @@ def plan_batches(episodes: int, workers: int, recording: bool) -> list[Batch]:
 
 def run_batch(session: Session, dataset: DatasetTarget | None, batch: Batch,
               on_episode: Callable[[EpisodeRun], None] | None = None) -> BatchDone:
-    """Run ``batch`` in ``session``; with a dataset, record it into the batch's shard and close it."""
+    """Run ``batch`` in ``session``; with a dataset, record it into the batch's shard and close it.
+
+    The dataset modules are imported only with a dataset: a run without one never loads them (they
+    import scipy.spatial among others: 0.3–0.5 s on the 2-core laptop, which a Ray actor, not
+    forked from a preloaded server, paid inside its first batch)."""
     import os
     import time
 
-    from robocfg.datasets.shards import close_shard
-
-    cpu0 = time.process_time()
+    wall0, cpu0 = time.time(), time.process_time()
     sink = dataset.sink(session.task, dataset.shard_root(batch.id)) if dataset is not None else None
     runs = []
     for k in batch.indices:
@@ -201,8 +206,12 @@ def run_batch(session: Session, dataset: DatasetTarget | None, batch: Batch,
         runs.append(run)
         if on_episode is not None:
             on_episode(run)
-    shard = close_shard(sink) if sink is not None else None
-    return BatchDone(batch, runs, shard, os.getpid(), (cpu0, time.process_time()))
+    shard = None
+    if sink is not None:
+        from robocfg.datasets.shards import close_shard
+
+        shard = close_shard(sink)
+    return BatchDone(batch, runs, shard, os.getpid(), (cpu0, time.process_time()), (wall0, time.time()))
 
 
 def report_in_driver(recipe: Recipe, records: list[Any], interrupted: bool) -> Any:
