@@ -146,9 +146,11 @@ def main() -> None:
         root = tmp / "size"
         row = _run(state, args.size_episodes, args.seed, "lerobot", root)
         t0 = time.perf_counter()
-        table = pq.read_table(root / "data/chunk-000/file-000.parquet")
+        files = sorted(root.glob("data/chunk-*/file-*.parquet"))  # rolled over at 100 MB
+        frames = sum(pq.read_table(p).num_rows for p in files)
         load = time.perf_counter() - t0
-        row |= {"bytes_on_disk": _dir_size(root), "frames": table.num_rows, "pyarrow_load_s": round(load, 4)}
+        row |= {"bytes_on_disk": _dir_size(root), "frames": frames, "data_files": len(files),
+                "pyarrow_load_s": round(load, 4)}
         res["size"] = row
     shutil.rmtree(tmp, ignore_errors=True)
     print(json.dumps(res, indent=2))

@@ -60,13 +60,15 @@ def main() -> None:
     if p.returncode not in (0, 1):
         sys.exit(f"run failed ({p.returncode}):\n{p.stderr[-3000:]}")
     peak_mib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024  # Linux: KiB
-    data = pq.ParquetFile(out / "data/chunk-000/file-000.parquet")
+    data_files = sorted(out.glob("data/chunk-*/file-*.parquet"))  # rolled over at 100 MB
+    row_groups = sum(pq.ParquetFile(p).num_row_groups for p in data_files)
     size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file())
     info = json.loads((out / "meta/info.json").read_text())
     row = {"code": args.code, "episodes": args.episodes, "size": args.size, "frames": info["total_frames"],
-           "peak_rss_mib": peak_mib, "dataset_mib": size / 2**20, "row_groups": data.num_row_groups, "wall_s": wall}
+           "peak_rss_mib": peak_mib, "dataset_mib": size / 2**20, "row_groups": row_groups,
+           "data_files": len(data_files), "wall_s": wall}
     print(f"code {args.code}: {args.episodes} episodes, {info['total_frames']} frames of {args.size}x{args.size} "
-          f"depth: peak RSS {peak_mib:.0f} MiB, dataset {size / 2**20:.0f} MiB, data row groups {data.num_row_groups}, "
+          f"depth: peak RSS {peak_mib:.0f} MiB, dataset {size / 2**20:.0f} MiB, data row groups {row_groups} in {len(data_files)} file(s), "
           f"wall {wall:.0f} s (load average {os.getloadavg()[0]:.2f})")
     if args.json:
         Path(args.json).write_text(json.dumps(row, indent=2) + "\n")

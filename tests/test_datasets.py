@@ -15,6 +15,7 @@ import pyarrow.parquet as pq
 import pytest
 import yaml
 from _cli import ROOT, run_main
+from _lerobot_conformance import check_lerobot
 
 from robocfg.checks import load_task
 from robocfg.datasets.language import pick_place_instruction
@@ -101,6 +102,16 @@ def test_lerobot_layout_dtypes_and_index_ranges(lerobot_ds):
     np.testing.assert_allclose(np.linalg.norm(obj[:, 3:], axis=1), 1.0, atol=1e-5)
     phases = data["phase_index"].to_numpy()
     assert set(info["robocfg"]["phases"][i] for i in np.unique(phases)) >= {"approach", "grasp", "transport", "retract"}
+
+
+def test_lerobot_conformance_of_a_recorded_dataset(lerobot_ds):
+    """The shared conformance check (pyarrow + PyAV; multi-file datasets: test_datasets_rollover);
+    two short episodes stay one file per series at lerobot's default limits."""
+    root, _ = lerobot_ds
+    seen = check_lerobot(root)
+    assert all(len(files) == 1 for files in seen.files.values()) and len(seen.files) == 4
+    info = json.loads((root / "meta/info.json").read_text())
+    assert (info["chunks_size"], info["data_files_size_in_mb"], info["video_files_size_in_mb"]) == (1000, 100, 200)
 
 
 def test_lerobot_depth_is_a_float32_height_by_width_feature_in_metres(lerobot_ds):

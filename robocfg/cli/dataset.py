@@ -15,16 +15,17 @@ DirArg = Annotated[Path, typer.Argument(help="Dataset directory (LeRobot v3.0) o
 
 @dataset_app.command("info")
 def info(path: DirArg, json_path: JsonOpt = None) -> int:
-    """Summarise a dataset. Episodes, frames, features (name and shape) and success rate."""
+    """Summarise a dataset. Episodes, frames, features (name and shape), success rate and (LeRobot) files per series."""
     from robocfg.datasets.read import read_info
 
     d = read_info(path)
     write_json(json_path, {"path": d.path, "format": d.format, "fps": d.fps, "robot": d.robot, "episodes": d.episodes,
                            "frames": d.frames, "successes": d.successes, "success_rate": d.success_rate,
-                           "features": d.features})
+                           "features": d.features, **({"files": d.files} if d.files else {})})
     rows = [("format", d.format), ("robot", d.robot), ("fps", str(d.fps)), ("episodes", str(d.episodes)),
             ("frames", str(d.frames)), ("success", f"{d.successes}/{d.episodes} ({d.success_rate:.1%})")]
     rows += [(f"feature {k}", "×".join(map(str, v)) or "scalar") for k, v in d.features.items()]
+    rows += [(f"files {series}", str(n)) for series, n in d.files.items()]  # LeRobot: files rolled over at the size limits
     console().print(key_value_table(f"dataset {d.path}", rows))
     return 0
 

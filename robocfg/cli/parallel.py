@@ -24,7 +24,7 @@ def run_distributed(checked: Any, options: Any, workers: int, executor: str, ray
     target = None
     if sink is not None:
         target = DatasetTarget(Path(sink.root).resolve(), sink.fmt, sink.fps, sink.keep, sink.language,
-                               dict(sink.extra_info), sink.renderer, sink.actions)
+                               dict(sink.extra_info), sink.renderer, sink.actions, sink.limits)
     recipe = EngineRecipe.of(checked, options, target)
     pool = _executor(executor, workers, ray_address)
     t0 = time.perf_counter()
@@ -39,7 +39,7 @@ def run_distributed(checked: Any, options: Any, workers: int, executor: str, ray
     timing = BatchTiming(time.perf_counter() - t0, [r.wall for r in runs], [r.physics for r in runs])
     if target is not None:
         options = dataclasses.replace(options, sink=MergedShards(execution.shards, target.root, target.fmt,
-                                                                 target.extra_info))
+                                                                 target.extra_info, target.limits))
     report = execution.report
     if options.resumed:  # the report of every finished episode, those of the interrupted run included
         from robocfg.executors.session import report_in_driver

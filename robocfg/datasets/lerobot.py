@@ -1,15 +1,21 @@
 """A LeRobot v3.0 dataset writer with pyarrow and PyAV only (no torch, no lerobot).
 
-Layout (one chunk, one file each; LeRobot starts a new file past 100 MB of data or 200 MB of video,
-which a robocfg run reaches only at tens of thousands of episodes)::
+Layout (``C`` chunk, ``F`` file: files roll over at lerobot's size limits, :mod:`robocfg.datasets.files`)::
 
-    meta/info.json                      codebase_version "v3.0", fps, features, totals, paths
+    meta/info.json                      codebase_version "v3.0", fps, features, totals, paths, file size limits
     meta/stats.json                     per-feature min/max/mean/std/count/q01..q99
     meta/tasks.parquet                  task string (pandas index) -> task_index
-    meta/episodes/chunk-000/file-000.parquet   one row per episode: length, index ranges,
-                                        video time ranges, tasks, and robocfg's outcome columns
-    data/chunk-000/file-000.parquet     one row per frame
-    videos/<key>/chunk-000/file-000.mp4 every episode's frames of one camera, back to back
+    meta/episodes/chunk-C/file-F.parquet   one row per episode: length, index ranges, the data file
+                                        and each camera's video file holding it with its time range
+                                        there, tasks, and robocfg's outcome columns
+    data/chunk-C/file-F.parquet         one row per frame, whole episodes per file
+    videos/<key>/chunk-C/file-F.mp4     the frames of one camera, episodes back to back
+
+A new data file starts when the current one would reach ``data_files_size_in_mb`` with the next
+episode, a new video file (per camera) at ``video_files_size_in_mb``, a new chunk directory every
+``chunks_size`` files (:class:`~robocfg.datasets.files.FileLimits`: lerobot 0.4.4's 100 MB, 200 MB
+and 1000 by default; a state-only run reaches 100 MB at about 600 000 frames, two 128x128 cameras'
+videos 200 MB at about 100 000).
 
 Depth (a camera with ``depth: true``) is a float32 feature ``observation.depth.<camera>`` of shape
 (H, W) in the data parquet, metres along the optical axis, stored exactly (a fixed-size list of
@@ -18,23 +24,24 @@ fixed-size lists: what ``LeRobotDataset`` loads as a ``datasets.Array2D``); its 
 1 mm histogram, so no frame is kept for them).
 
 The data parquet is streamed: each episode's rows are buffered and written as a row group once
-the buffer holds ``ROW_GROUP_BYTES`` (and at ``close()``), so a writer holds at most that much of
-the frames' data, whatever the number of episodes (depth is 64 KiB a frame at 128×128). Where to
-cut depends only on the episodes in order, so a merged dataset cuts where a single process does.
-A dataset under ``ROW_GROUP_BYTES`` (state only: tens of thousands of frames) is one row group,
-as ``pyarrow.parquet.write_table`` writes it. The vector features (state, actions: ≈ 150 bytes a
-frame) are also kept until ``close()``, for their exact quantiles in ``stats.json``.
+the buffer holds ``ROW_GROUP_BYTES`` (and when the file ends), so a writer holds at most that much
+of the frames' data, whatever the number of episodes (depth is 64 KiB a frame at 128×128). Where
+to cut depends only on the episodes in order, so a merged dataset cuts where a single process
+does. A data file under ``ROW_GROUP_BYTES`` (state only: tens of thousands of frames) is one row
+group, as ``pyarrow.parquet.write_table`` writes it. The vector features (state, actions: ≈ 150
+bytes a frame) are also kept until ``close()``, for their exact quantiles in ``stats.json``.
 
 Timestamps are ``frame_index / fps``; an episode's video frames start at its
-``videos/<key>/from_timestamp``. Videos: H.264 (libx264), yuv420p, a keyframe every 2 frames
-(LeRobot's own choice, for exact random access), each episode encoded on its own and the
-episodes' packets joined (:mod:`robocfg.datasets.video`), so shards written by several workers
-merge into the very bytes one process would write (:mod:`robocfg.datasets.shards`).
+``videos/<key>/from_timestamp`` in the file its ``videos/<key>/chunk_index`` and ``file_index``
+name (frames before it in that file / fps; 0 for a file's first episode). Videos: H.264
+(libx264), yuv420p, a keyframe every 2 frames (LeRobot's own choice, for exact random access),
+each episode encoded on its own and the episodes' packets joined (:mod:`robocfg.datasets.video`),
+so shards written by several workers merge into the very bytes one process would write
+(:mod:`robocfg.datasets.shards`).
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -42,13 +49,14 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
+from robocfg.datasets.files import FileLimits, FileSeries
+from robocfg.datasets.lerobot_meta import write_episodes, write_json, write_table, write_tasks
 from robocfg.datasets.stats import DepthStats, ImageStats, vector_stats
 from robocfg.datasets.video import EncodedVideo, VideoConcat, encode_episode
 
 CODEBASE_VERSION = "v3.0"
 DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
 VIDEO_PATH = "videos/{video_key}/chunk-{chunk_index:03d}/file-{file_index:03d}.mp4"
-EPISODES_PATH = "meta/episodes/chunk-000/file-000.parquet"
 ROW_GROUP_BYTES = 32 << 20  # frame data buffered before it is written as one parquet row group
 STATE, ENV, ACTION = "observation.state", "observation.environment_state", "action"
 ACTION_JOINT, ACTION_EE = "action.joint", "action.ee_delta"  # the second action feature (--dataset-actions)
@@ -90,10 +98,12 @@ def joint_action_key(layout_actions: str) -> str:
 
 
 class LeRobotWriter:
-    """Add episodes one by one (videos are encoded as they come), then ``close()``."""
+    """Add episodes one by one (videos are encoded as they come), then ``close()``; ``limits``:
+    when data and video files roll over (lerobot's defaults)."""
 
-    def __init__(self, root: Path, layout: DatasetLayout, extra_info: dict):
+    def __init__(self, root: Path, layout: DatasetLayout, extra_info: dict, limits: FileLimits | None = None):
         self.root, self.layout, self.extra_info = Path(root), layout, extra_info
+        self.limits = limits = limits or FileLimits()
         self.root.mkdir(parents=True, exist_ok=True)
         self.columns: dict[str, list[np.ndarray]] = {k: [] for k in (STATE, ENV, ACTION, ACTION_JOINT, ACTION_EE,
                                                                      "phase_index", "episode_index", "frame_index",
@@ -101,9 +111,10 @@ class LeRobotWriter:
         self.episodes: list[dict] = []
         self.tasks: dict[str, int] = {}
         self.frames = 0
-        self.videos = {c.name: VideoConcat(self.root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
-                                                                         file_index=0), layout.fps)
-                       for c in layout.cameras}
+        self._data = FileSeries(limits.data_files_size_in_mb, limits.chunks_size)
+        self._video_files = {c.name: FileSeries(limits.video_files_size_in_mb, limits.chunks_size)
+                             for c in layout.cameras}
+        self.videos = {c.name: VideoConcat(self._video_path(c.name), layout.fps) for c in layout.cameras}
         self.image_stats = {c.name: ImageStats() for c in layout.cameras}
         self.depth_stats = {c.name: DepthStats() for c in layout.cameras if c.depth}
         self._pending: list[pa.Table] = []  # episodes' data rows not yet written
@@ -132,17 +143,24 @@ class LeRobotWriter:
         cols["task_index"] = np.full(n, task_index, np.int64)
         for key, arr in cols.items():
             self.columns[key].append(arr)
-        self._add_rows(self._rows(cols, depth, self.frames, n))
+        rows = self._rows(cols, depth, self.frames, n)
+        if self._data.rolls(rows.nbytes):  # the episode starts the next data file
+            self._end_data_file()
+        self._data.add(rows.nbytes)
+        self._add_rows(rows)
         row = {"episode_index": k, "tasks": [ep.language], "length": n,
-               "data/chunk_index": 0, "data/file_index": 0,
+               "data/chunk_index": self._data.chunk, "data/file_index": self._data.file,
                "dataset_from_index": self.frames, "dataset_to_index": self.frames + n}
-        for name, video in self.videos.items():
-            key = image_key(name)
-            t0 = video.frames / self.layout.fps
-            video.append(videos[name])
-            row |= {f"videos/{key}/chunk_index": 0, f"videos/{key}/file_index": 0,
+        for name in self.videos:
+            key, files = image_key(name), self._video_files[name]
+            if files.add(len(videos[name].data)):  # the episode starts the camera's next video file
+                self.videos[name].close()
+                self.videos[name] = VideoConcat(self._video_path(name), self.layout.fps)
+            t0 = self.videos[name].frames / self.layout.fps
+            self.videos[name].append(videos[name])
+            row |= {f"videos/{key}/chunk_index": files.chunk, f"videos/{key}/file_index": files.file,
                     f"videos/{key}/from_timestamp": t0, f"videos/{key}/to_timestamp": t0 + n / self.layout.fps}
-        row |= {"meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0,
+        row |= {"meta/episodes/chunk_index": 0, "meta/episodes/file_index": 0,  # set by close()
                 "success": ep.success, "failed_phase": ep.failed_phase, "reason": ep.reason, "seed": ep.seed,
                 "run_episode": ep.index, "physics_steps": ep.physics_steps, "object_final": ep.object_final}
         self.episodes.append(row)
@@ -166,6 +184,11 @@ class LeRobotWriter:
                 arrays[depth_key(c.name)] = _fixed_list(depth[c.name].reshape(n, c.height, c.width), c.width, c.height)
         return pa.table(arrays)
 
+    def _video_path(self, camera: str) -> Path:
+        """The camera's current video file."""
+        f = self._video_files[camera]
+        return self.root / VIDEO_PATH.format(video_key=image_key(camera), chunk_index=f.chunk, file_index=f.file)
+
     def _add_rows(self, rows: pa.Table) -> None:
         """Buffer an episode's rows; write the buffer as a row group once it holds ``ROW_GROUP_BYTES``."""
         self._pending.append(rows)
@@ -179,10 +202,17 @@ class LeRobotWriter:
         table = pa.concat_tables(self._pending).combine_chunks()
         self._pending, self._pending_bytes = [], 0
         if self._parquet is None:
-            path = self.root / DATA_PATH.format(chunk_index=0, file_index=0)
+            path = self.root / DATA_PATH.format(chunk_index=self._data.chunk, file_index=self._data.file)
             path.parent.mkdir(parents=True, exist_ok=True)
             self._parquet = pq.ParquetWriter(path, table.schema)
         self._parquet.write_table(table)
+
+    def _end_data_file(self) -> None:
+        """Write the buffered rows to the current data file and close it."""
+        self._flush()
+        if self._parquet is not None:
+            self._parquet.close()
+            self._parquet = None
 
     def _actions(self, ep: EpisodeRecord) -> list[tuple[str, np.ndarray]]:
         """(feature key, (T, D) array) of the episode's actions as the layout stores them."""
@@ -206,20 +236,17 @@ class LeRobotWriter:
         """Write the parquet files and metadata; returns the dataset root."""
         for v in self.videos.values():
             v.close()
-        self._flush()
-        if self._parquet is not None:
-            self._parquet.close()
-            self._parquet = None
+        if self._parquet is not None or self._pending:
+            self._end_data_file()
         else:  # no episode: the columns with no row
             empty = {k: np.zeros(0) for k in self.columns}
             depth = {c.name: np.zeros((0, c.height, c.width)) for c in self.layout.cameras if c.depth}
-            _write(self._rows(empty, depth, 0, 0), self.root / DATA_PATH.format(chunk_index=0, file_index=0))
+            write_table(self._rows(empty, depth, 0, 0), self.root / DATA_PATH.format(chunk_index=0, file_index=0))
         cols = {k: np.concatenate(v) if v else np.zeros(0) for k, v in self.columns.items()}
         n = self.frames
         dims = vector_dims(self.layout)
-        _write(pa.Table.from_pylist(self.episodes) if self.episodes else pa.table({"episode_index": pa.array([], pa.int64())}),
-               self.root / EPISODES_PATH)
-        _write_tasks(self.tasks, self.root / "meta/tasks.parquet")
+        write_episodes(self.root, self.episodes, self.limits)
+        write_tasks(self.tasks, self.root / "meta/tasks.parquet")
         stats = {key: vector_stats(cols[key].reshape(n, d)) for key, d in dims.items()} if n else {}
         if n:
             scalars = {"timestamp": (cols["frame_index"] / self.layout.fps).astype(np.float32),
@@ -228,8 +255,8 @@ class LeRobotWriter:
                 stats[key] = vector_stats(scalars[key] if key in scalars else cols[key].astype(np.int64))
             stats |= {image_key(c): s.result() for c, s in self.image_stats.items()}
             stats |= {depth_key(c): s.result() for c, s in self.depth_stats.items()}
-        _json(self.root / "meta/stats.json", stats)
-        _json(self.root / "meta/info.json", self._info())
+        write_json(self.root / "meta/stats.json", stats)
+        write_json(self.root / "meta/info.json", self._info())
         return self.root
 
     def _info(self) -> dict:
@@ -251,7 +278,7 @@ class LeRobotWriter:
         return {
             "codebase_version": CODEBASE_VERSION, "robot_type": lay.robot,
             "total_episodes": len(self.episodes), "total_frames": self.frames, "total_tasks": len(self.tasks),
-            "chunks_size": 1000, "data_files_size_in_mb": 100, "video_files_size_in_mb": 200, "fps": lay.fps,
+            **self.limits.info(), "fps": lay.fps,
             "splits": {"train": f"0:{len(self.episodes)}"}, "data_path": DATA_PATH,
             "video_path": VIDEO_PATH if lay.cameras else None, "features": features,
             "robocfg": {"phases": list(lay.phases), "task_name": lay.task_name, "actions": lay.actions, **self.extra_info,
@@ -268,30 +295,3 @@ def _fixed_list(x: np.ndarray, d: int, rows: int | None = None) -> pa.Array:
     an (N, rows, d) array, read by ``datasets`` as an Array2D)."""
     a = pa.FixedSizeListArray.from_arrays(pa.array(np.asarray(x, np.float32).reshape(-1)), d)
     return a if rows is None else pa.FixedSizeListArray.from_arrays(a, rows)
-
-
-def _write(table: pa.Table, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    pq.write_table(table, path)
-
-
-def _write_tasks(tasks: dict[str, int], path: Path) -> None:
-    """``tasks.parquet`` as pandas writes a DataFrame indexed by the task string (LeRobot reads it
-    with ``pandas.read_parquet`` and looks tasks up by index)."""
-    names = sorted(tasks, key=lambda t: tasks[t])
-    meta = {"index_columns": ["__index_level_0__"],
-            "column_indexes": [{"name": None, "field_name": None, "pandas_type": "unicode", "numpy_type": "object",
-                                "metadata": {"encoding": "UTF-8"}}],
-            "columns": [{"name": "task_index", "field_name": "task_index", "pandas_type": "int64", "numpy_type": "int64",
-                         "metadata": None},
-                        {"name": None, "field_name": "__index_level_0__", "pandas_type": "unicode",
-                         "numpy_type": "object", "metadata": None}],
-            "creator": {"library": "pyarrow", "version": pa.__version__}, "pandas_version": "2.2.3"}
-    table = pa.table({"task_index": pa.array([tasks[t] for t in names], pa.int64()),
-                      "__index_level_0__": pa.array(names, pa.string())})
-    _write(table.replace_schema_metadata({b"pandas": json.dumps(meta).encode()}), path)
-
-
-def _json(path: Path, obj: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(obj, indent=2) + "\n")

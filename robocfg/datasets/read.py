@@ -4,7 +4,7 @@ summary figures for ``robocfg dataset info`` and one episode's actions and outco
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +42,7 @@ class DatasetInfo:
     successes: int
     features: dict[str, list[int]]
     run: dict
+    files: dict[str, int] = field(default_factory=dict)  # LeRobot: files per series (data, meta/episodes, each video key)
 
     @property
     def success_rate(self) -> float:
@@ -57,6 +58,18 @@ def dataset_format(root: Path) -> str:
     raise RobocfgError(f"{root}: not a robocfg dataset (no meta/info.json, no data.hdf5)")
 
 
+def _file_counts(root: Path) -> dict[str, int]:
+    """A LeRobot dataset's number of files in each series: ``data``, ``meta/episodes``, ``videos/<key>``."""
+    from robocfg.datasets.files import series_files
+
+    counts = {"data": len(series_files(root / "data")),
+              "meta/episodes": len(series_files(root / "meta/episodes"))}
+    videos = root / "videos"
+    if videos.is_dir():
+        counts |= {f"videos/{d.name}": len(series_files(d, "mp4")) for d in sorted(videos.iterdir()) if d.is_dir()}
+    return counts
+
+
 def _h5_path(root: Path) -> Path:
     return root if root.is_file() else root / "data.hdf5"
 
@@ -64,14 +77,15 @@ def _h5_path(root: Path) -> Path:
 def read_info(root: Path) -> DatasetInfo:
     root = Path(root)
     if dataset_format(root) == "lerobot":
-        import pyarrow.parquet as pq
+        from robocfg.datasets.lerobot_meta import read_episodes
 
         info = json.loads((root / "meta/info.json").read_text())
-        eps = pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").to_pylist()
+        eps = read_episodes(root)
+        successes = sum(bool(s) for s in eps["success"].to_pylist()) if "success" in eps.column_names else 0
         shapes = {k: list(v["shape"]) for k, v in info["features"].items()}
         run = info.get("robocfg", {})
         return DatasetInfo(str(root), "lerobot", info["fps"], info.get("robot_type") or "", info["total_episodes"],
-                           info["total_frames"], sum(bool(e.get("success")) for e in eps), shapes, run)
+                           info["total_frames"], successes, shapes, run, _file_counts(root))
     import h5py
 
     with h5py.File(_h5_path(root), "r") as f:
@@ -97,11 +111,13 @@ def read_episode(root: Path, k: int) -> EpisodeMeta:
         import pyarrow.compute as pc
         import pyarrow.parquet as pq
 
-        from robocfg.datasets.lerobot import joint_action_key
+        from robocfg.datasets.lerobot import DATA_PATH, joint_action_key
+        from robocfg.datasets.lerobot_meta import read_episodes
 
-        e = pq.read_table(root / "meta/episodes/chunk-000/file-000.parquet").to_pylist()[k]
+        e = read_episodes(root).slice(k, 1).to_pylist()[0]
         key = joint_action_key(read_info(root).run.get("actions", "joint"))
-        data = pq.read_table(root / "data/chunk-000/file-000.parquet", columns=["episode_index", "frame_index", key])
+        path = root / DATA_PATH.format(chunk_index=e["data/chunk_index"], file_index=e["data/file_index"])
+        data = pq.read_table(path, columns=["episode_index", "frame_index", key])  # the file holding episode k
         rows = data.filter(pc.equal(data["episode_index"], k))
         actions = np.asarray(rows[key].to_pylist(), np.float64)[np.argsort(rows["frame_index"].to_numpy())]
         return EpisodeMeta(k, e["run_episode"], e["seed"], bool(e["success"]), e["failed_phase"], e["reason"],

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from robocfg.datasets.episode import DatasetLayout, EpisodeRecord
+from robocfg.datasets.files import FileLimits
 from robocfg.datasets.sink import DatasetSink, DatasetSummary, Format, make_writer
 from robocfg.datasets.stats import ImageStats
 
@@ -56,16 +57,17 @@ def close_shard(sink: DatasetSink) -> Shard:
 
 
 def merge_shards(shards: list[Shard], out: Path, fmt: Format, extra_info: dict,
-                 remove: bool = True) -> DatasetSummary:
+                 remove: bool = True, limits: FileLimits | None = None) -> DatasetSummary:
     """Write the episodes of ``shards`` into the dataset ``out`` ordered by their episode index
-    in the run; ``remove`` deletes the shard folders afterwards."""
+    in the run (a LeRobot dataset's files rolled over at ``limits``, as one writer does);
+    ``remove`` deletes the shard folders afterwards."""
     out = Path(out)
     layouts = [s.layout for s in shards if s.layout is not None]
     run = sum(s.episodes_run for s in shards)
     if not layouts:  # no episode ran (every worker lost): an empty dataset is still no dataset
         return DatasetSummary(str(out), fmt, 0, run, 0)
     layout = layouts[0]
-    writer = make_writer(fmt, out, layout, extra_info)
+    writer = make_writer(fmt, out, layout, extra_info, limits)
     frames = kept = 0
     for ep, videos in _in_order([s for s in shards if s.episodes_kept], layout):
         if fmt == "lerobot":
@@ -111,26 +113,23 @@ def _summed_histograms(shards: list[Shard]) -> dict[str, ImageStats]:
 
 
 def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeRecord, dict]]:
-    import pyarrow.parquet as pq
-
     from robocfg.datasets.lerobot import (
         ACTION,
         ACTION_EE,
         ACTION_JOINT,
-        DATA_PATH,
         ENV,
-        EPISODES_PATH,
         STATE,
         VIDEO_PATH,
         depth_key,
         image_key,
         vector_dims,
     )
+    from robocfg.datasets.lerobot_meta import read_data, read_episodes
     from robocfg.datasets.video import split_segments
 
     root = Path(shard.path)
-    rows = pq.read_table(root / EPISODES_PATH).to_pylist()
-    data = pq.read_table(root / DATA_PATH.format(chunk_index=0, file_index=0))
+    rows = read_episodes(root).to_pylist()
+    data = read_data(root)  # every data file of the shard, in order
     dims = vector_dims(layout)
     cols = {k: np.asarray(data[k].combine_chunks().flatten().to_numpy(zero_copy_only=False)) for k in dims}
     vec = {k: cols[k].astype(np.float32).reshape(-1, d) for k, d in dims.items()}
@@ -139,10 +138,14 @@ def _read_lerobot(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeReco
     phase = data["phase_index"].to_numpy().astype(np.int64)
     depth = {c.name: np.asarray(data[depth_key(c.name)].combine_chunks().flatten().flatten().to_numpy(), np.float32)
              .reshape(-1, c.height, c.width) for c in layout.cameras if c.depth}
-    lengths = [r["length"] for r in rows]
-    segments = {c.name: split_segments(root / VIDEO_PATH.format(video_key=image_key(c.name), chunk_index=0,
-                                                                  file_index=0), layout.fps, lengths)
-                for c in layout.cameras}
+    segments: dict[str, list] = {}
+    for c in layout.cameras:  # each video file's episodes, in order, back as standalone segments
+        key = image_key(c.name)
+        segments[c.name] = []
+        for (chunk, file), group in itertools.groupby(rows, key=lambda r: (r[f"videos/{key}/chunk_index"],
+                                                                           r[f"videos/{key}/file_index"])):
+            path = root / VIDEO_PATH.format(video_key=key, chunk_index=chunk, file_index=file)
+            segments[c.name] += split_segments(path, layout.fps, [r["length"] for r in group])
     out = []
     for i, r in enumerate(rows):
         a, b = r["dataset_from_index"], r["dataset_to_index"]
@@ -185,12 +188,14 @@ def _read_hdf5(shard: Shard, layout: DatasetLayout) -> list[tuple[EpisodeRecord,
 class MergedShards:
     """The dataset sink of a distributed run's driver: the workers recorded into ``shards``;
     ``close()`` merges them into ``root`` (and removes ``root/.shards``), like a single-process
-    sink's ``close()`` writes its dataset."""
+    sink's ``close()`` writes its dataset (with its file ``limits``)."""
 
-    def __init__(self, shards: list[Shard], root: Path, fmt: Format, extra_info: dict):
+    def __init__(self, shards: list[Shard], root: Path, fmt: Format, extra_info: dict,
+                 limits: FileLimits | None = None):
         self.shards, self.root, self.fmt, self.extra_info = shards, Path(root), fmt, extra_info
+        self.limits = limits
 
     def close(self) -> DatasetSummary:
-        summary = merge_shards(self.shards, self.root, self.fmt, self.extra_info)
+        summary = merge_shards(self.shards, self.root, self.fmt, self.extra_info, limits=self.limits)
         shutil.rmtree(self.root / ".shards", ignore_errors=True)
         return summary

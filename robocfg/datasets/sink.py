@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from robocfg.datasets.episode import Actions, CameraLayout, DatasetLayout
+from robocfg.datasets.files import FileLimits
 from robocfg.datasets.recorder import EpisodeRecorder, layout_names
 from robocfg.engine.dataset import EpisodeObjects, object_keys
 
@@ -26,11 +27,12 @@ Format = Literal["lerobot", "hdf5"]
 Keep = Literal["success", "all"]
 
 
-def make_writer(fmt: Format, root: Path, layout: DatasetLayout, extra_info: dict):
+def make_writer(fmt: Format, root: Path, layout: DatasetLayout, extra_info: dict, limits: FileLimits | None = None):
+    """The writer of ``fmt``; ``limits``: when a LeRobot dataset's files roll over (HDF5 is one file)."""
     if fmt == "lerobot":
         from robocfg.datasets.lerobot import LeRobotWriter
 
-        return LeRobotWriter(root, layout, extra_info)
+        return LeRobotWriter(root, layout, extra_info, limits)
     from robocfg.datasets.hdf5 import Hdf5Writer
 
     return Hdf5Writer(root, layout, extra_info)
@@ -53,7 +55,8 @@ class DatasetSink:
 
     ``language``: the task string stored with every episode whose kind gives none; ``extra_info``:
     run facts stored in the dataset metadata (task path, arm, seed) that replay needs;
-    ``renderer``: how camera images are drawn (``robocfg.sim.camera_rig``: auto, tiny, exact, egl).
+    ``renderer``: how camera images are drawn (``robocfg.sim.camera_rig``: auto, tiny, exact, egl);
+    ``limits``: when a LeRobot dataset's data and video files roll over (lerobot's defaults).
     """
 
     root: Path
@@ -65,6 +68,7 @@ class DatasetSink:
     extra_info: dict = field(default_factory=dict)
     renderer: Renderer = "auto"
     actions: Actions = "joint"  # --dataset-actions
+    limits: FileLimits = field(default_factory=FileLimits)  # --dataset-data-mb, --dataset-video-mb, --dataset-chunk-files
     writer: Any = field(default=None, init=False)
     layout: DatasetLayout | None = field(default=None, init=False)
     run: int = field(default=0, init=False)
@@ -85,7 +89,7 @@ class DatasetSink:
                 fps=self.fps, robot=arm.robot.name, task_name=self.task.path.stem, state_names=state,
                 env_state_names=env, action_names=action, phases=tuple(phases) or ("run",),
                 cameras=tuple(CameraLayout(c.name, c.height, c.width, c.depth) for c in cams), actions=self.actions)
-            self.writer = make_writer(self.fmt, Path(self.root), self.layout, self.extra_info)
+            self.writer = make_writer(self.fmt, Path(self.root), self.layout, self.extra_info, self.limits)
         if self._rig is None or self._rig[0] is not world:
             if self._rig is not None:
                 self._rig[1].close()

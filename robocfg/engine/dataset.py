@@ -61,6 +61,15 @@ class DatasetOptions:
         "--dataset-renderer", choices=("auto", "tiny", "exact", "egl"),
         help="Camera images: tiny (TinyRenderer on low-poly copies, CPU), egl (PyBullet's EGL plugin, GPU), "
              "auto (egl where an NVIDIA GPU is, else tiny) or exact (TinyRenderer on the full meshes; slowest)."))
+    dataset_data_mb: float = field(default=100.0, metadata=option(
+        "--dataset-data-mb", help="LeRobot: start a new data parquet file when the current one would reach this "
+                                  "many MB (2**20 bytes) with the next episode (lerobot's data_files_size_in_mb)."))
+    dataset_video_mb: float = field(default=200.0, metadata=option(
+        "--dataset-video-mb", help="LeRobot: start a new video file (per camera) when the current one would reach "
+                                   "this many MB with the next episode (lerobot's video_files_size_in_mb)."))
+    dataset_chunk_files: int = field(default=1000, metadata=option(
+        "--dataset-chunk-files", minimum=1, help="LeRobot: files per chunk-NNN directory, at most 1000 (lerobot's "
+                                                 "chunks_size)."))
 
 
 class EpisodeTap(Protocol):

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+from robocfg.datasets.files import FileLimits
+
 if TYPE_CHECKING:
     from robocfg.datasets.episode import Actions
     from robocfg.datasets.shards import Shard
@@ -100,6 +102,7 @@ class DatasetTarget:
     extra_info: dict = field(default_factory=dict)
     renderer: Renderer = "auto"  # camera images (robocfg.sim.camera_rig)
     actions: Actions = "joint"  # which actions are stored (--dataset-actions)
+    limits: FileLimits = field(default_factory=FileLimits)  # when LeRobot files roll over (shards and the merge)
 
     def shard_root(self, batch: int) -> Path:
         return Path(self.root) / ".shards" / f"batch-{batch:05d}"
@@ -108,7 +111,8 @@ class DatasetTarget:
         from robocfg.datasets.sink import DatasetSink
 
         return DatasetSink(root, self.fmt, task, fps=self.fps, keep=self.keep, language=self.language,
-                           extra_info=dict(self.extra_info), renderer=self.renderer, actions=self.actions)
+                           extra_info=dict(self.extra_info), renderer=self.renderer, actions=self.actions,
+                           limits=self.limits)
 
 
 @dataclass(frozen=True)
