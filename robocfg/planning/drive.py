@@ -4,7 +4,10 @@ A move to an EE pose: IK for the goal (seeded from the current joints; if that a
 a few seeded restarts for a collision-free one), a collision-free joint path from the
 :class:`JointPlanner`, toppra timing, then the same trajectory playback and convergence check as
 every other move. A held object is attached to the hand's collision model while it is carried
-(:meth:`PlannedDrive.attach`), so neither it nor the arm is planned through the scene.
+(:meth:`PlannedDrive.attach`), so neither it nor the arm is planned through the scene, and the
+hand keeps the orientation it carries it with along the path (:mod:`.level`: a hand turned by the
+path's random samples shifts the object between the pads, which PyBullet then holds at several
+points a pad, at twice the cost a step).
 
 Build the drive once per run (:func:`build_planned_drive`): it convex-hulls every collision mesh.
 Frames: world, 4×4, metres; joints in arm order, rad.
@@ -45,6 +48,7 @@ class PlannedDrive:
     base_dir: Path = Path(".")  # resolves the task's relative mesh paths (the task file's folder)
     loose: list[str] = field(default_factory=list)  # scene.objects avoided where they lie at each move
     paths: list[PlannedPath] = field(default_factory=list)
+    held_at: dict[str, np.ndarray] = field(default_factory=dict)  # held objects' centres in the EE frame (m)
 
     @property
     def checker(self) -> CollisionChecker:
@@ -56,9 +60,11 @@ class PlannedDrive:
         from robocfg.collision.bodies import body_env_shape
 
         self.checker.attach(name, body_env_shape(body, T_ee_body, self.base_dir), self.ee_link)
+        self.held_at[name] = np.asarray(T_ee_body, float)[:3, 3].copy()
 
     def detach(self, name: str) -> None:
         self.checker.detach(name)
+        self.held_at.pop(name, None)
 
     def refresh_loose(self, world: World, ignore: Sequence[str] = ()) -> None:
         """Move the loose objects of the collision model to where they lie in ``world`` now; one
@@ -131,6 +137,8 @@ class PlannedDrive:
             path = self.planner.plan(q0, q_goal)
         except PlanningFailed as exc:
             raise PhaseFailed(mover.phase, exc.reason) from None
+        if self.checker.held:  # carry the object as it was picked up (:mod:`.level`)
+            path = self.levelled(mover, path)
         self.paths.append(path)
         # a held object is carried no harder than the grip holds it (the mover's max_acceleration),
         # as on every other timed move: uniformly slower along the same (checked) path
@@ -145,6 +153,23 @@ class PlannedDrive:
             reason = check()
             if reason:
                 raise PhaseFailed(mover.phase, reason)
+
+    def levelled(self, mover: ArmMover, path: PlannedPath) -> PlannedPath:
+        """``path`` with the hand held at its goal's orientation, turned about the held objects'
+        centre (:func:`robocfg.planning.level.level_path`): still collision-free."""
+        from dataclasses import replace
+
+        from robocfg.planning.level import level_path
+        from robocfg.planning.shortcut import path_length
+
+        def solve(T: np.ndarray, seed: np.ndarray) -> np.ndarray | None:
+            res = self.kin.ik(T, seed_q=seed, frame="ee", time_budget=mover.ik_budget)
+            return res.q if res.converged else None
+
+        pivot = np.mean(list(self.held_at.values()), axis=0) if self.held_at else np.zeros(3)
+        W = level_path(path.waypoints, self.checker, lambda q: self.kin.fk(q, "ee"), solve,
+                       self.planner.settings.resolution, pivot)
+        return replace(path, waypoints=W, length=path_length(W))
 
 
 def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
