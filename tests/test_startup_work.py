@@ -83,3 +83,27 @@ def test_pad_gap_curve_with_the_chain_memo_is_bit_identical(robot: Path) -> None
                                              dict(zip(leaders, qc + k * (qo - qc), strict=True)), AXIS_INDEX[arm.ee_axis]),
                                   closing_axis(arm.R_ee_graspnet)) for k in s])
         assert gaps.tobytes() == plain.tobytes() and np.ptp(gaps) > 0
+
+
+def test_a_pick_place_process_to_its_first_episode_parses_no_builtin_signature() -> None:
+    """pydantic reads each ``default_factory``'s signature; a builtin's (``list``) is parsed with
+    ``tokenize``, whose first use compiles its regular expressions. The config models' list
+    fields use ``robocfg.config.types.new_list``, so a process validating its task and running
+    its first episode never does."""
+    code = ("import tokenize\n"
+            "from robocfg.checks.task import load_task; from robocfg.config import catalog\n"
+            "from robocfg.engine import RunOptions, open_session\n"
+            "s = open_session(load_task(catalog.find('tasks', 'pick_place')), RunOptions(seed=0))\n"
+            "assert s.run(0).success; s.close()\n"
+            "assert tokenize._compile.cache_info().currsize == 0, 'tokenize compiled'")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_config_list_fields_default_to_a_new_empty_list() -> None:
+    from robocfg.config.scene import Scene
+    from robocfg.config.types import new_list
+
+    a, b = Scene(), Scene()
+    assert a.objects == [] and a.objects is not b.objects  # a new list each time, as `list` gave
+    assert Scene.model_fields["objects"].default_factory is new_list

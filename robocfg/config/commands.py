@@ -7,7 +7,15 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from robocfg.config.scene import Body
-from robocfg.config.types import FiniteFloat, Frozen, NonNegFloat, Pose, PositiveFloat, Vec3
+from robocfg.config.types import (
+    FiniteFloat,
+    Frozen,
+    NonNegFloat,
+    Pose,
+    PositiveFloat,
+    Vec3,
+    new_list,
+)
 
 
 class GripperParams(Frozen):
@@ -75,8 +83,8 @@ class Motion(Frozen):
     radius: PositiveFloat = 0.1
     period: PositiveFloat = 4.0
     plane: Literal["xy", "yz", "xz"] = "yz"
-    waypoints: list[Vec3] = Field(default_factory=list)
-    waypoint_times: list[NonNegFloat] = Field(default_factory=list)
+    waypoints: list[Vec3] = Field(default_factory=new_list)
+    waypoint_times: list[NonNegFloat] = Field(default_factory=new_list)
     loop: bool = Field(False, description="waypoints: start over after the last one.")
 
     @model_validator(mode="after")
@@ -134,7 +142,7 @@ class FollowTargetParams(Frozen):
                             "between the tool axes). auto: free for a suction gripper, symmetric for a parallel "
                             "gripper, tracked otherwise (a one-jaw gripper, no gripper).")
     with_obstacle: bool = False
-    obstacles: list[FollowObstacle] = Field(default_factory=list, description="Spawned only with with_obstacle (or --with-obstacle).")
+    obstacles: list[FollowObstacle] = Field(default_factory=new_list, description="Spawned only with with_obstacle (or --with-obstacle).")
     duration: PositiveFloat = 8.0
     control_rate: PositiveFloat = Field(240.0, description="Hz.")
     safety_margin: PositiveFloat = Field(0.02, description="m.")
@@ -255,11 +263,11 @@ class GraspParams(Frozen):
     """
 
     camera: Camera = Field(default_factory=Camera)
-    objects: list[Body] = Field(default_factory=list)
+    objects: list[Body] = Field(default_factory=new_list)
     num_candidates: int = Field(200, ge=1)
     top_k: int = Field(10, ge=1)
     lift_height: PositiveFloat = 0.15
-    extra_cameras: list[Camera] = Field(default_factory=list, description="More views fused into the one cloud.")
+    extra_cameras: list[Camera] = Field(default_factory=new_list, description="More views fused into the one cloud.")
     workspace: Workspace = Field(default_factory=Workspace)
     voxel_size: PositiveFloat = Field(0.004, description="Voxel grid leaf (m) for downsampling.")
     friction: PositiveFloat = Field(0.5, description="Friction coefficient assumed by the planner (friction-cone half angle atan μ).")

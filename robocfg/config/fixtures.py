@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from robocfg.config.types import Pose, PositiveFloat, Vec3, Vec4
+from robocfg.config.types import Pose, PositiveFloat, Vec3, Vec4, new_list
 
 if TYPE_CHECKING:
     from robocfg.config.scene import Body
@@ -84,7 +84,7 @@ class ShelfFixture(_FixtureBase):
 
     type: Literal["shelf"] = Field(description="Selects the fixture kind.")
     board: PositiveFloat = Field(0.02, description="Board, side and back thickness (m).")
-    levels: list[PositiveFloat] = Field(default_factory=list, description="Heights (m above the footprint) of the top faces of the intermediate boards.")
+    levels: list[PositiveFloat] = Field(default_factory=new_list, description="Heights (m above the footprint) of the top faces of the intermediate boards.")
 
     @model_validator(mode="after")
     def _levels_inside(self):

@@ -21,6 +21,7 @@ from robocfg.config.types import (
     PositiveFloat,
     SchemaVersion,
     Vec3,
+    new_list,
 )
 from robocfg.suggest import did_you_mean
 
@@ -115,8 +116,8 @@ class GripperKeypoints(Frozen):
 class CollisionFilter(Frozen):
     """Link name lists for contact handling."""
 
-    ignore_links: list[str] = Field(default_factory=list, description="Links whose contacts with the object are ignored.")
-    forbid_links: list[str] = Field(default_factory=list, description="Arm links that must never touch anything.")
+    ignore_links: list[str] = Field(default_factory=new_list, description="Links whose contacts with the object are ignored.")
+    forbid_links: list[str] = Field(default_factory=new_list, description="Arm links that must never touch anything.")
 
 
 class ArmConfig(Frozen):
@@ -216,7 +217,7 @@ class RobotConfig(Frozen):
     urdf: str = Field(description="Path relative to this YAML, or pybullet_data://, airo_models://, package://.")
     package_dirs: dict[str, str] = Field(default_factory=dict, description="package:// name → directory.")
     attachments: list[Attachment] = Field(
-        default_factory=list, description="URDFs welded onto the robot (grippers, tools), composed into one URDF in order."
+        default_factory=new_list, description="URDFs welded onto the robot (grippers, tools), composed into one URDF in order."
     )
     fixed_base: bool = Field(True, description="Weld the URDF root link to the world (PyBullet useFixedBase).")
     arms: list[ArmConfig] = Field(min_length=1, description="One entry per arm.")
@@ -262,4 +263,4 @@ class RobotSource(Frozen):
 
     urdf: str = Field(description="Path relative to this YAML, or pybullet_data://, airo_models://, package://.")
     package_dirs: dict[str, str] = Field(default_factory=dict, description="package:// name → directory.")
-    attachments: list[Attachment] = Field(default_factory=list, description="URDFs welded onto the robot, in order.")
+    attachments: list[Attachment] = Field(default_factory=new_list, description="URDFs welded onto the robot, in order.")

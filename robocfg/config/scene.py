@@ -7,7 +7,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_validator
 
 from robocfg.config.fixtures import Fixture
-from robocfg.config.types import Frozen, NonNegFloat, Pose, PositiveFloat, Vec3, Vec4
+from robocfg.config.types import Frozen, NonNegFloat, Pose, PositiveFloat, Vec3, Vec4, new_list
 
 Color = Vec4
 
@@ -64,9 +64,9 @@ class Scene(Frozen):
     ground: bool = Field(True, description="Add a ground plane at z = 0.")
     table: Table | None = Field(None, description="Optional static table.")
     pedestal: Pedestal | None = Field(None, description="Optional static pedestal (place the robot on its top face).")
-    objects: list[Body] = Field(default_factory=list, description="Movable objects (names unique among objects and obstacles).")
-    obstacles: list[Body] = Field(default_factory=list, description="Static obstacles (mass is ignored).")
-    fixtures: list[Fixture] = Field(default_factory=list, description="Static fixtures built from boxes: bins (type: bin), shelves with levels (type: shelf), blocks (type: block); parts are named FIXTURE/PART.")
+    objects: list[Body] = Field(default_factory=new_list, description="Movable objects (names unique among objects and obstacles).")
+    obstacles: list[Body] = Field(default_factory=new_list, description="Static obstacles (mass is ignored).")
+    fixtures: list[Fixture] = Field(default_factory=new_list, description="Static fixtures built from boxes: bins (type: bin), shelves with levels (type: shelf), blocks (type: block); parts are named FIXTURE/PART.")
 
     def fixture_parts(self) -> list[Body]:
         """Every fixture's boxes (static bodies, world poses)."""

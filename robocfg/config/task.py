@@ -16,7 +16,7 @@ from robocfg.config.commands import (
 )
 from robocfg.config.multi_pick import PickPlaceManyParams
 from robocfg.config.scene import Scene, Sim
-from robocfg.config.types import Frozen, Pose, SchemaVersion
+from robocfg.config.types import Frozen, Pose, SchemaVersion, new_list
 
 if TYPE_CHECKING:
     from typing_extensions import TypeForm  # PEP 747; typing has it from Python 3.14
@@ -27,7 +27,7 @@ class RobotMount(Pose):
 
     robot: str | None = Field(None, description="Robot name on the search path (e.g. 'panda').")
     robot_config_file: str | None = Field(None, description="Path to a robot YAML, relative to this task file.")
-    ignore_substring: list[str] = Field(default_factory=list, description="Bodies whose name contains one of these do not collide with the robot.")
+    ignore_substring: list[str] = Field(default_factory=new_list, description="Bodies whose name contains one of these do not collide with the robot.")
 
     @model_validator(mode="after")
     def _one_source(self) -> RobotMount:
@@ -44,7 +44,7 @@ class TaskBase(Frozen):
     robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
     scene: Scene = Field(default_factory=Scene, description="Everything in the world besides the robots.")
     sim: Sim = Field(default_factory=Sim, description="Simulation settings.")
-    cameras: list[TaskCamera] = Field(default_factory=list, description="Cameras recorded into datasets (--dataset); none: state only.")
+    cameras: list[TaskCamera] = Field(default_factory=new_list, description="Cameras recorded into datasets (--dataset); none: state only.")
     variants: dict[str, dict[str, JsonValue]] = Field(
         default_factory=dict,
         description="Per-robot changes: robot name → {dotted key: value} (as `--set`), applied when that robot "
