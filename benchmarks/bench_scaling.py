@@ -2,16 +2,19 @@
 interleaved rounds.
 
     python benchmarks/bench_scaling.py [--workers 1,2,4,8,16] [--per-worker 16] [--rounds 5] [--ray]
-                                       [--dataset] [--no-in-process] [--json out.json]
+                                       [--ray-kept] [--dataset] [--no-in-process] [--json out.json]
 
 Weak scaling: a run of worker count w runs ``per-worker × w`` episodes of the shipped pick-place task
 without cameras (seed 0) through the executors the CLI uses (``--workers``: a process pool;
 ``--ray``: Ray actors on a local Ray started once, before any timing, as ``--executor ray`` starts
-one — workers at the driver's niceness — with ``num_cpus`` = the largest worker count;
-``--ray-worker-niceness 15`` gives Ray's own default). Each round runs, for every worker count, the pool and Ray one after the
-other, pool first in even rounds and Ray first in odd ones (A B, B A, A B ...), so slow drifts of a
-shared host's load fall on both alike; every figure is a median over the rounds, with its spread
-(min–max), and Ray ÷ pool is taken within each round (paired) before its median.
+one — workers at the driver's niceness — with ``num_cpus`` = the largest worker count, twice that
+with ``--ray-kept``; ``--ray-worker-niceness 15`` gives Ray's own default; ``--ray-kept``: Ray
+actors kept from one run to the next, ``RayPool(keep=True)``, so a run's start is the world build
+in a process that has robocfg imported, as a pool worker's is). Each round runs, for every worker
+count, the pool and Ray one after the other, who goes first rotating from round to round (A B, B A,
+A B ...; A B C, B C A, C A B ... with three), so slow drifts of a shared host's load fall on all
+alike; every figure is a median over the rounds, with its spread (min–max), and Ray ÷ pool is taken
+within each round (paired) before its median.
 
 What a run measures, each part apart:
 
@@ -43,6 +46,10 @@ What a run measures, each part apart:
   every other process it started (fork server; Ray's raylet, GCS, agents and idle workers) during
   the run ÷ episodes (needs psutil). ``cpu ms/ep`` is their sum: the machine's CPU per episode.
 
+*Core speed* (printed first): a fixed pure-Python loop's CPU time alone ÷ with w copies at once
+— what the machine's cores give when w of them are busy (turbo limits, shared caches), the part of
+the *cpu* factor below that no executor can change.
+
 Efficiency = steady pool throughput at w ÷ (w × the 1-worker pool's), per round. ``rounds ±5 %`` is
 how many rounds bound the median of a paired ratio to about ±5 % at 95 % (``(2 s / 0.05)²``, ``s``
 the standard deviation of the ratio's logarithm over the rounds), for the wall ratio and for the
@@ -60,10 +67,13 @@ import json
 import math
 import os
 import statistics
+import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+RAY_KINDS = ("ray", "ray-kept")  # Ray actors started for each run (as the CLI does), kept actors reused
 
 
 @dataclass
@@ -223,7 +233,7 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
 
     target = _target(dataset, task)
     recipe = EngineRecipe.of(task, RunOptions(seed=0, episodes=episodes), target)
-    pool = RayPool(workers) if kind == "ray" else ProcessPool(workers)
+    pool = RayPool(workers, keep=kind == "ray-kept") if kind in RAY_KINDS else ProcessPool(workers)
     asked = time.time()
     t0 = time.perf_counter()
     pool.start(recipe)
@@ -259,6 +269,46 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
                   if all(hasattr(b, "wall") for b in out.done) else None)  # older robocfg: no stamps
 
 
+def _settle(tree: TreeCpu, limit: float = 30.0) -> float:
+    """Wait until this process and those under it (a local Ray's prestarted workers booting) use
+    under half a core over 0.5 s, at most ``limit`` s; return how long it took."""
+    t0 = time.perf_counter()
+    while time.perf_counter() - t0 < limit:
+        before = tree.snapshot(set())
+        time.sleep(0.5)
+        used = tree.between(before, tree.snapshot(set()))
+        if math.isnan(used) or used < 0.25:  # NaN without psutil
+            break
+    return time.perf_counter() - t0
+
+
+def _spin(n: int) -> float:
+    """CPU time (s) of ``n`` iterations of a fixed pure-Python loop in this process."""
+    t, x = time.process_time(), 0
+    for i in range(n):
+        x += i * i
+    return time.process_time() - t
+
+
+def core_speed(counts: list[int], n: int = 3_000_000) -> dict[int, float]:
+    """For each worker count w: the CPU time of a fixed pure-Python loop alone ÷ its median CPU time
+    with w copies running at once in w processes (1.0: a core is as fast with w busy; < 1: cores
+    slow down when many are busy — turbo limits, shared caches, hyper-threads — which no executor
+    changes). Processes from the same fork server the pool uses."""
+    import multiprocessing as mp
+
+    ctx = mp.get_context("forkserver")
+    out = {}
+    alone = None
+    for w in sorted(set(counts)):
+        with ctx.Pool(w) as p:
+            p.map(_spin, [n // 20] * w)  # all started and warm
+            cpu = statistics.median(p.map(_spin, [n] * w, chunksize=1))
+        alone = cpu if alone is None else alone
+        out[w] = alone / cpu
+    return out
+
+
 def start_costs(task) -> tuple[float, float, float]:
     """(fresh process, first pool worker, next pool worker) start times (s): a new interpreter that
     imports robocfg and opens a pick-place session (world, model, controllers); a process pool's
@@ -289,6 +339,23 @@ def start_costs(task) -> tuple[float, float, float]:
     return fresh, times[0], times[1]
 
 
+def _cpu_model() -> str:
+    """The CPU's model name and its physical cores (Linux ``/proc/cpuinfo``; psutil)."""
+    model = "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            model = next((ln.split(":", 1)[1].strip() for ln in f if ln.startswith("model name")), "?")
+    except OSError:
+        pass
+    try:
+        import psutil
+
+        physical = psutil.cpu_count(logical=False)
+    except ImportError:
+        physical = None
+    return f"{model}, {physical} physical cores, {os.cpu_count()} logical"
+
+
 def _spread(values: list[float], fmt: str = ".3f") -> str:
     """``median [min–max]`` of ``values``."""
     v = [x for x in values if x == x]
@@ -309,12 +376,12 @@ def _pct(values: list[float]) -> str:
     return f"{50 * (max(v) - min(v)) / statistics.median(v):.0f}" if len(v) > 1 else ""
 
 
-def _break_even(samples: list[Sample]) -> int | None:
+def _break_even(samples: list[Sample], ray_kind: str = "ray") -> int | None:
     """Episodes per worker from which Ray's throughput with its start is ≥ 0.9 × the pool's (median
     starts S and steady seconds per episode per worker τ: n ≥ (0.9 S_ray − S_pool) / (τ_pool − 0.9 τ_ray));
     None without both executors, or when Ray's steady rate alone is below 0.9 × the pool's."""
     pool = [s for s in samples if s.executor == "pool"]
-    ray = [s for s in samples if s.executor == "ray"]
+    ray = [s for s in samples if s.executor == ray_kind]
     if not pool or not ray:
         return None
     s_p, s_r = _med([s.start_s for s in pool]), _med([s.start_s for s in ray])
@@ -336,7 +403,8 @@ def rounds_needed(ratios: list[float], half_width: float = 0.05) -> int | None:
 def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
     """Print the tables; return them as JSON-ready data."""
     by = {(s.executor, s.workers, s.round): s for s in samples}
-    kinds = [k for k in ("in-process", "pool", "ray") if any(s.executor == k for s in samples)]
+    kinds = [k for k in ("in-process", "pool", *RAY_KINDS) if any(s.executor == k for s in samples)]
+    ray_kinds = [k for k in RAY_KINDS if k in kinds] or ["ray"]
     print(f"\n{'executor':<11}{'w':>3}{'eps':>5}{'steady ep/s':>12}{'±%':>5}{'ep/s+start':>11}{'start s':>8}"
           f"{'spawn s':>8}{'boot s':>7}{'build s':>8}{'episode ms':>11}{'±%':>5}{'1st ms':>7}{'worker ms/ep':>13}{'driver+ ms/ep':>14}"
           f"{'cpu ms/ep':>10}{'ok':>9}")
@@ -373,13 +441,13 @@ def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
                           "successes": sum(s.successes for s in rows)})
     print("(medians over the rounds; ±%: half the spread, max − min, in % of the median, of the runs' steady ep/s"
           " and of their median episode CPU)")
-    print(f"\n{'workers':>7}  {'pool efficiency':<24}{'ray/pool steady':<24}{'ray/pool +start':<24}"
+    print(f"\n{'ray as':<9}{'workers':>7}  {'pool efficiency':<24}{'ray/pool steady':<24}{'ray/pool +start':<24}"
           f"{'ray/pool episode cpu':<24}{'ray/pool cpu/ep':<24}{'rounds ±5 % (wall, cpu)':<25}{'n for +start ≥ 0.9':<18}")
     paired = []
-    for w in counts:
+    for ray_kind, w in itertools.product(ray_kinds, counts):
         eff, vs, vs_start, vs_ep, vs_cpu = [], [], [], [], []
         for r in range(rounds):
-            p, p1, y = by.get(("pool", w, r)), by.get(("pool", 1, r)), by.get(("ray", w, r))
+            p, p1, y = by.get(("pool", w, r)), by.get(("pool", 1, r)), by.get((ray_kind, w, r))
             if p is not None and p1 is not None:
                 eff.append(p.eps / (w * p1.eps))
             if p is not None and y is not None:
@@ -389,11 +457,11 @@ def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
                 if y.cpu_per_episode == y.cpu_per_episode:
                     vs_cpu.append(p.cpu_per_episode / y.cpu_per_episode)  # > 1: Ray cheaper
         need, need_cpu = rounds_needed(vs), rounds_needed(vs_ep)
-        n_even = _break_even([s for s in samples if s.workers == w])
-        print(f"{w:>7}  {_spread(eff, '.2f'):<24}{_spread(vs, '.2f'):<24}{_spread(vs_start, '.2f'):<24}"
+        n_even = _break_even([s for s in samples if s.workers == w], ray_kind)
+        print(f"{ray_kind:<9}{w:>7}  {_spread(eff, '.2f'):<24}{_spread(vs, '.2f'):<24}{_spread(vs_start, '.2f'):<24}"
               f"{_spread(vs_ep, '.3f'):<24}{_spread(vs_cpu, '.3f'):<24}{f'{need}, {need_cpu}':<25}"
               f"{'-' if n_even is None else n_even}")
-        paired.append({"workers": w, "pool_efficiency": eff, "ray_over_pool": vs, "ray_over_pool_with_start": vs_start,
+        paired.append({"ray": ray_kind, "workers": w, "pool_efficiency": eff, "ray_over_pool": vs, "ray_over_pool_with_start": vs_start,
                        "ray_over_pool_episode_cpu": vs_ep, "pool_cpu_over_ray_cpu_per_episode": vs_cpu,
                        "rounds_for_5pct": need, "rounds_for_5pct_episode_cpu": need_cpu,
                        "episodes_per_worker_for_ray_with_start_0_9": n_even})
@@ -423,10 +491,10 @@ def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> di
     """Print where each run's worker-seconds went (:class:`TimeLine`) and the efficiency and Ray ÷
     pool split into factors (:func:`_factors`); return both as JSON-ready data."""
     print("\nWhere the workers' time went (% of workers × run s; medians over the rounds):")
-    print(f"{'executor':<9}{'w':>3}{'run s':>7}{'episodes':>9}{'had core':>9}{'lead':>7}{'batch':>7}{'gaps':>7}"
+    print(f"{'executor':<10}{'w':>3}{'run s':>7}{'episodes':>9}{'had core':>9}{'lead':>7}{'batch':>7}{'gaps':>7}"
           f"{'ms/gap':>7}{'imbal.':>7}{'end':>7}{'end ms':>7}")
     rows = []
-    for kind in ("pool", "ray"):
+    for kind in ("pool", *RAY_KINDS):
         for w in counts:
             runs = [s for s in samples if s.executor == kind and s.workers == w and s.time_line is not None]
             if not runs:
@@ -437,7 +505,7 @@ def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> di
             had_core = [100 * t.episode_cpu / t.episodes for t in tl if t is not None]
             ms_gap = [1e3 * t.gaps / t.n_gaps for t in tl if t is not None and t.n_gaps]
             end_ms = [1e3 * t.end / w for t in tl if t is not None]
-            print(f"{kind:<9}{w:>3}{_med([s.run_s for s in runs]):>7.2f}{_med(share['episodes']):>9.1f}"
+            print(f"{kind:<10}{w:>3}{_med([s.run_s for s in runs]):>7.2f}{_med(share['episodes']):>9.1f}"
                   f"{_med(had_core):>9.1f}{_med(share['lead']):>7.1f}{_med(share['batch']):>7.1f}{_med(share['gaps']):>7.1f}"
                   f"{_med(ms_gap):>7.2f}{_med(share['imbalance']):>7.1f}{_med(share['end']):>7.1f}{_med(end_ms):>7.0f}")
             rows.append({"executor": kind, "workers": w, "percent": share, "had_core_percent": had_core,
@@ -447,16 +515,21 @@ def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> di
           " dataset); imbal.: idle after its last batch while others finish; end: the last batch → run() returned"
           " (report, stopping workers), end ms: its length)")
     by = {(s.executor, s.workers, s.round): s for s in samples}
-    print(f"\n{'workers':>7}  {'pool efficiency = cpu × core × busy':<44}{'ray/pool steady = cpu × core × busy':<44}")
+    ray_kinds = [k for k in RAY_KINDS if any(s.executor == k for s in samples)]
+    print(f"\n{'workers':>7}  {'pool efficiency = cpu × core × busy':<36}"
+          + "".join(f"{k + '/pool steady = cpu × core × busy':<42}" for k in ray_kinds))
     factors = []
     for w in counts:
-        eff, vs = [], []
+        eff: list[tuple[float, float, float]] = []
+        vs: dict[str, list[tuple[float, float, float]]] = {k: [] for k in ray_kinds}
         for r in range(rounds):
-            p, p1, y = by.get(("pool", w, r)), by.get(("pool", 1, r)), by.get(("ray", w, r))
+            p, p1 = by.get(("pool", w, r)), by.get(("pool", 1, r))
             if p is not None and p1 is not None and (f := _factors(p, p1)) is not None:
                 eff.append(f)
-            if p is not None and y is not None and (f := _factors(y, p)) is not None:
-                vs.append(f)
+            for k in ray_kinds:
+                y = by.get((k, w, r))
+                if p is not None and y is not None and (f := _factors(y, p)) is not None:
+                    vs[k].append(f)
 
         def cols(fs: list[tuple[float, float, float]]) -> str:
             if not fs:
@@ -464,7 +537,7 @@ def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> di
             return (f"{_med([a * b * c for a, b, c in fs]):.2f} = {_med([f[0] for f in fs]):.2f} × "
                     f"{_med([f[1] for f in fs]):.2f} × {_med([f[2] for f in fs]):.2f}")
 
-        print(f"{w:>7}  {cols(eff):<44}{cols(vs):<44}")
+        print(f"{w:>7}  {cols(eff):<36}" + "".join(f"{cols(vs[k]):<42}" for k in ray_kinds))
         factors.append({"workers": w, "pool_efficiency_factors": eff, "ray_over_pool_factors": vs})
     print("(medians over the rounds of each factor; cpu: episode CPU of the reference ÷ this one's (< 1: episodes"
           " cost more CPU — slower cores when all are busy, shared caches); core: share of episode wall with a core,"
@@ -481,6 +554,8 @@ def main() -> None:
     ap.add_argument("--per-worker", type=int, default=16, help="episodes per worker in each run")
     ap.add_argument("--rounds", type=int, default=3, help="interleaved rounds (pool and Ray alternate first)")
     ap.add_argument("--ray", action="store_true", help="also run each worker count on Ray actors")
+    ap.add_argument("--ray-kept", action="store_true",
+                    help="also run each worker count on kept Ray actors (RayPool(keep=True): processes reused across runs)")
     ap.add_argument("--ray-worker-niceness", type=int, default=None,
                     help="niceness of the local Ray's workers (default: robocfg's, 0; Ray's own default is 15)")
     ap.add_argument("--dataset", action="store_true", help="record a state-only LeRobot dataset (shards merged)")
@@ -505,41 +580,54 @@ def main() -> None:
         return tmp / f"ds{n_ds[0]}" if args.dataset else None
 
     load0 = os.getloadavg()[0]
-    print(f"cores: {cores}   load average: {load0:.2f}   episodes per worker: {args.per_worker}   rounds: {args.rounds}"
-          f"   dataset: {'state-only LeRobot' if args.dataset else 'none'}")
+    print(f"cores: {cores} ({_cpu_model()})   load average: {load0:.2f}   episodes per worker: {args.per_worker}"
+          f"   rounds: {args.rounds}   dataset: {'state-only LeRobot' if args.dataset else 'none'}   python {sys.version.split()[0]}")
     fresh, first, warm = start_costs(task)
     print(f"start to an open session: fresh process {fresh:.2f} s, pool worker {warm:.2f} s "
           f"(first pool of this process, fork server start included: {first:.2f} s)")
+    speed = core_speed(counts)
+    print("core speed with w processes busy (a fixed pure-Python loop's CPU time alone ÷ with w at once): "
+          + ", ".join(f"w={w} {f:.2f}" for w, f in speed.items()))
     tree = TreeCpu()
     samples = [] if args.no_in_process else [in_process(task, args.per_worker, ds())]
-    if args.ray:
+    kinds = ["pool", *(["ray"] if args.ray else []), *(["ray-kept"] if args.ray_kept else [])]
+    if len(kinds) > 1:
         import ray
 
         from robocfg.executors import ray_pool
 
         if args.ray_worker_niceness is not None:
             ray_pool.WORKER_NICENESS = args.ray_worker_niceness
-        ray_pool.init_ray(ray, num_cpus=max(counts))
+        # Ray CPUs are counted, not bound: kept actors hold theirs while idle, so fresh actors beside
+        # them need as many again
+        ray_cpus = max(counts) * (len(kinds) - 1)
+        ray_pool.init_ray(ray, num_cpus=ray_cpus)
+        waited = _settle(TreeCpu())
+        print(f"local Ray {ray.__version__} started with num_cpus={ray_cpus} before any timing"
+              f" (then {waited:.1f} s until its prestarted workers were idle)")
     for rnd in range(args.rounds):
         for w in counts:
-            kinds = ["pool", "ray"] if args.ray else ["pool"]
-            for kind in kinds if rnd % 2 == 0 else kinds[::-1]:
+            order = kinds[rnd % len(kinds):] + kinds[:rnd % len(kinds)]  # who goes first rotates
+            for kind in order:
                 s = distributed(task, kind, w, w * args.per_worker, rnd, ds(), tree)
                 samples.append(s)
                 if rnd == 0 and w == counts[0]:
                     print(f"  {kind} workers' niceness: {sorted(set(s.niceness))} (driver: {os.nice(0)})")
-                print(f"  round {rnd} {kind:<4} w={w:<2} start {s.start_s:5.2f} s  run {s.run_s:6.2f} s  "
+                print(f"  round {rnd} {kind:<8} w={w:<2} start {s.start_s:5.2f} s  run {s.run_s:6.2f} s  "
                       f"{s.eps:6.3f} ep/s  episode cpu {1e3 * statistics.median(s.episode_cpu):4.0f} ms  "
                       f"load {os.getloadavg()[0]:.2f}", flush=True)
-    if args.ray:
+    if len(kinds) > 1:
         import ray
 
+        from robocfg.executors.ray_pool import release_kept
+
+        release_kept(ray)
         ray.shutdown()
     out = summarise(samples, counts, args.rounds)
     print(f"load average: {load0:.2f} before, {os.getloadavg()[0]:.2f} after")
     if args.json:
         Path(args.json).write_text(json.dumps({"cores": cores, "per_worker": args.per_worker, "rounds": args.rounds,
-                                               "dataset": args.dataset, **out}, indent=2) + "\n")
+                                               "dataset": args.dataset, "core_speed": speed, **out}, indent=2) + "\n")
 
 
 if __name__ == "__main__":

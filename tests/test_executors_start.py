@@ -68,3 +68,27 @@ def test_a_local_ray_started_for_the_run_gives_its_actors_the_drivers_niceness()
         if ray.is_initialized():
             ray.shutdown()
     assert not out.lost and len(out.records) == 1
+
+
+def test_kept_ray_actors_open_the_next_recipe_in_the_same_process_with_the_same_results():
+    """``RayPool(keep=True)``: after a run the actors stay (sessions closed); the next kept run
+    reopens its own recipe in those processes and gives what new actors give."""
+    from robocfg.executors import ray_pool
+
+    other = EngineRecipe.of(load_task(catalog.find("tasks", "pick_place")), RunOptions(seed=9, episodes=2))
+    ray.init(num_cpus=2, include_dashboard=False)
+    try:
+        fresh = RayPool(1).run(other, plan_batches(2, 1, False))
+        RayPool(1, keep=True).run(_recipe(1), plan_batches(1, 1, False))
+        assert len(ray_pool._KEPT.actors) == 1
+        pid = ray.get(ray_pool._KEPT.actors[0].pid.remote())
+        kept = RayPool(1, keep=True)
+        kept.start(other)
+        assert [s.pid for s in kept.starts] == [pid] and not ray_pool._KEPT.actors  # the kept process, taken
+        out = kept.run(other, plan_batches(2, 1, False))
+        assert len(ray_pool._KEPT.actors) == 1
+        ray_pool.release_kept(ray)
+        assert not ray_pool._KEPT.actors
+    finally:
+        ray.shutdown()
+    assert out.records == fresh.records and out.report == fresh.report and not out.lost

@@ -8,6 +8,14 @@ folder, so on a cluster that folder must be on a filesystem every node shares (s
 ``docs/scale-out.md``); the driver merges them. An actor that dies (node lost, process killed)
 surfaces as ``RayActorError`` on its calls: those batches are reported lost and the others go on.
 
+Kept actors (``RayPool(..., keep=True)``, for a process that makes several runs on one Ray: a
+notebook, a service, a benchmark): after a run its actors are not ended but keep their process,
+with robocfg imported, and close their session; the next kept run in this process reopens its
+recipe in them, so its start is the world build alone — as a process pool's worker forks from a
+fork server that has imported robocfg once — instead of a new interpreter per actor. Idle kept
+actors hold their CPU in Ray; :func:`release_kept` ends them (a Ray shut down by robocfg ends them
+too). The CLI, one run per process, does not keep actors.
+
 Where Ray runs: ``address`` (``--ray-address``), else ``RAY_ADDRESS``, else a local Ray started
 here and shut down after the run. A Ray already initialised in this process (a test, a notebook)
 is used as it is.
@@ -28,6 +36,7 @@ import os
 import time
 from collections import deque
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 from robocfg.errors import RobocfgError
@@ -48,16 +57,40 @@ IN_FLIGHT = 2  # actor calls queued per actor: it never waits for the driver bet
 WORKER_NICENESS = 0  # niceness increment of a local Ray's workers (Ray's own default: 15)
 
 
+@dataclass
+class _Kept:
+    """Actors that ``RayPool(keep=True)`` runs left alive, their sessions closed, for the next such
+    run in this process while the same Ray job (``job``) runs."""
+
+    job: str | None = None
+    actors: list[Any] = field(default_factory=list)
+
+
+_KEPT = _Kept()
+
+
 class _Actor:
-    """A Ray actor holding one session."""
+    """A Ray actor holding one session (opened from a recipe; reopened for another by ``open``)."""
 
     def __init__(self, recipe: Recipe):
+        self.session: Any = None
+        self.open(recipe)
+
+    def open(self, recipe: Recipe) -> WorkerStart:
+        """Close the session this actor holds, if any, and open ``recipe``'s."""
         opening = time.time()
+        self.close()
         for module in recipe.preload:  # what a pool's fork server imports: here, in the actor's start
             importlib.import_module(module)
         self.recipe = recipe
         self.session = recipe.open()
         self.start = worker_start(opening)
+        return self.start
+
+    def close(self) -> None:
+        if self.session is not None:
+            self.session.close()
+            self.session = None
 
     def pid(self) -> int:
         return os.getpid()
@@ -75,10 +108,10 @@ class _Actor:
 class RayPool:
     """Run a recipe's episodes on ``workers`` Ray actors (see the module docstring)."""
 
-    def __init__(self, workers: int, address: str | None = None):
+    def __init__(self, workers: int, address: str | None = None, keep: bool = False):
         if workers < 1:
             raise RobocfgError(f"--workers {workers}: need at least 1")
-        self.workers, self.address = workers, address
+        self.workers, self.address, self.keep = workers, address, keep
         self.actors: list[Any] = []
         self.starts: list[WorkerStart] = []  # how each actor started, filled by start()
         self._started: tuple[Recipe, bool] | None = None  # the actors' recipe, and whether Ray was started here
@@ -101,20 +134,44 @@ class RayPool:
             raise WorkerError(f"a Ray actor could not start: {_first_line(exc)}") from exc
 
     def _start_actors(self, ray: Any, recipe: Recipe, count: int) -> None:
-        remote = ray.remote(num_cpus=1, max_restarts=0)(_Actor)
-        self.actors = [remote.remote(recipe) for _ in range(count)]
+        """``count`` actors holding ``recipe``'s session: with ``keep``, idle kept actors first (each
+        reopens its session; one that died meanwhile is replaced), new ones for the rest."""
+        from ray.exceptions import RayActorError
 
-    def _stop(self, ray: Any, shutdown: bool) -> None:
-        for a in self.actors:
-            ray.kill(a)
+        remote = ray.remote(num_cpus=1, max_restarts=0)(_Actor)
+        job = ray.get_runtime_context().get_job_id()
+        if job != _KEPT.job:  # kept under another Ray (shut down and started again): gone with it
+            _KEPT.job, _KEPT.actors = job, []
+        reused = [_KEPT.actors.pop() for _ in range(min(count, len(_KEPT.actors)))] if self.keep else []
+        opened = [a.open.remote(recipe) for a in reused]
+        self.actors = [remote.remote(recipe) for _ in range(count - len(reused))]
+        for a, ref in zip(reused, opened, strict=True):
+            try:
+                ray.get(ref)
+                self.actors.append(a)
+            except RayActorError:
+                self.actors.append(remote.remote(recipe))
+
+    def _stop(self, ray: Any, shutdown: bool, keep: bool = False) -> None:
+        """End the actors (with ``keep``: close their sessions and keep them for the next kept run),
+        and shut Ray down when it was started here."""
+        if keep and not shutdown:
+            for a in self.actors:
+                a.close.remote()
+            _KEPT.actors.extend(self.actors)
+        else:
+            for a in self.actors:
+                ray.kill(a)
         self.actors = []
         if shutdown:
+            release_kept(ray)
             ray.shutdown()
 
     def run(self, recipe: Recipe, batches: list[Batch], on_episode: Callable[[EpisodeRun], None] | None = None,
             should_stop: Callable[[], bool] | None = None) -> Execution:
         """Run ``batches`` on the actors :meth:`start` started for this recipe, else on new ones
-        (one per worker, each kept for all the batches); the actors end when it returns."""
+        (one per worker, each kept for all the batches); the actors end when it returns (with
+        ``keep``, after a run that lost no episode, they stay, idle, for the next kept run)."""
         ray = _ray()
         from ray.exceptions import RayActorError, RayTaskError
 
@@ -131,6 +188,7 @@ class RayPool:
             self._start_actors(ray, recipe, result.workers)
         todo = deque(batches)
         inflight: dict[Any, tuple[Any, Batch]] = {}
+        kept = False  # the actors go back to the kept ones only after a run that lost none
 
         def hand_out(actor: Any) -> None:
             if todo:
@@ -163,9 +221,16 @@ class RayPool:
             for batch in todo:
                 result.lost.append(LostEpisodes(batch.indices, "no Ray actor left to run it"))
             result.report = _report_of(ray, self.actors, recipe, result)
+            kept = self.keep and not result.lost
         finally:
-            self._stop(ray, started)
+            self._stop(ray, started, keep=kept)
         return result
+
+
+def release_kept(ray: Any) -> None:
+    """End the actors that ``RayPool(keep=True)`` runs kept (they hold a CPU each while idle)."""
+    while _KEPT.actors:
+        ray.kill(_KEPT.actors.pop())
 
 
 def _ray() -> Any:
