@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import psutil
 from _cli import ROOT
 
@@ -66,3 +67,28 @@ def test_batches_carry_their_wall_clock_span_and_the_workers_all_stop():
         bs.sort(key=lambda b: b.wall[0])
         assert all(a.wall[1] <= b.wall[0] for a, b in itertools.pairwise(bs))
     assert not any(psutil.pid_exists(p) and psutil.Process(p).status() != psutil.STATUS_ZOMBIE for p in pids)
+
+
+def _finish_spread(sizes_of: list[tuple[int, ...]], workers: int, duration: list[float]) -> float:
+    """Hand ``sizes_of`` (batches' episode indices) to whichever of ``workers`` is free first, as
+    the executors do; episode k takes ``duration[k]``: the spread of the workers' finishing times."""
+    free = [0.0] * workers
+    for indices in sizes_of:
+        i = free.index(min(free))
+        free[i] += sum(duration[k] for k in indices)
+    return max(free) - min(free)
+
+
+def test_recording_batches_shrink_so_the_workers_finish_within_one_episode():
+    rng = np.random.default_rng(0)
+    for episodes, workers in [(256, 16), (64, 2), (1000, 8), (37, 3), (128, 16)]:
+        batches = plan_batches(episodes, workers, True)
+        assert [k for b in batches for k in b.indices] == list(range(episodes))
+        assert [b.id for b in batches] == list(range(len(batches)))
+        sizes = [len(b.indices) for b in batches]
+        assert max(sizes) <= 8 and sizes == sorted(sizes, reverse=True) and sizes[-1] == 1
+        assert len(batches) <= episodes // 2 + 2 * workers  # still fewer shards than episodes
+        for _ in range(20):  # episodes of unequal length (0.5-1.5 units): the tail stays one episode
+            duration = list(rng.uniform(0.5, 1.5, episodes))
+            assert _finish_spread([b.indices for b in batches], workers, duration) <= 1.5
+    assert all(len(b.indices) == 1 for b in plan_batches(256, 16, False))

@@ -185,11 +185,21 @@ class ReportRequest:
 
 
 def plan_batches(episodes: int, workers: int, recording: bool) -> list[Batch]:
-    """Consecutive index ranges. Without a dataset a batch is one episode (a crash loses one);
-    with one, up to 8 episodes share a shard (fewer files to merge), keeping at least 4 batches
-    per worker so the workers finish together."""
-    size = 1 if not recording else max(1, min(8, episodes // (4 * max(1, workers))))
-    return [Batch(i, tuple(range(a, min(a + size, episodes)))) for i, a in enumerate(range(0, episodes, size))]
+    """Consecutive index ranges, handed out in order to whichever worker is free. Without a dataset
+    a batch is one episode (a crash loses one). With one, up to 8 episodes share a shard (fewer files
+    to merge), in batches that shrink as the run goes (guided self-scheduling: a batch is the
+    remaining episodes ÷ 2 × workers, rounded up, at most 8), so the last batches are single
+    episodes and the workers finish within about one episode of each other — a fixed size left a
+    worker up to a quarter of its share behind the others. Which episodes share a shard does not
+    change the merged dataset."""
+    w = max(1, workers)
+    batches: list[Batch] = []
+    a = 0
+    while a < episodes:
+        size = 1 if not recording else max(1, min(8, -(-(episodes - a) // (2 * w))))
+        batches.append(Batch(len(batches), tuple(range(a, min(a + size, episodes)))))
+        a += size
+    return batches
 
 
 def run_batch(session: Session, dataset: DatasetTarget | None, batch: Batch,
