@@ -50,6 +50,10 @@ What a run measures, each part apart:
 — what the machine's cores give when w of them are busy (turbo limits, shared caches), the part of
 the *cpu* factor below that no executor can change.
 
+Before each run the benchmark waits (up to 10 s, printed) until the processes under it use under
+half a core: the previous run's workers leaving and Ray starting idle workers to replace killed
+actors' processes would otherwise fall into the next run's timing.
+
 Efficiency = steady pool throughput at w ÷ (w × the 1-worker pool's), per round. ``rounds ±5 %`` is
 how many rounds bound the median of a paired ratio to about ±5 % at 95 % (``(2 s / 0.05)²``, ``s``
 the standard deviation of the ratio's logarithm over the rounds), for the wall ratio and for the
@@ -270,8 +274,9 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
 
 
 def _settle(tree: TreeCpu, limit: float = 30.0) -> float:
-    """Wait until this process and those under it (a local Ray's prestarted workers booting) use
-    under half a core over 0.5 s, at most ``limit`` s; return how long it took."""
+    """Wait until this process and those under it (a local Ray's prestarted workers booting, the
+    last run's workers leaving) use under half a core over 0.5 s, at most ``limit`` s; return how
+    long it took."""
     t0 = time.perf_counter()
     while time.perf_counter() - t0 < limit:
         before = tree.snapshot(set())
@@ -609,13 +614,14 @@ def main() -> None:
         for w in counts:
             order = kinds[rnd % len(kinds):] + kinds[:rnd % len(kinds)]  # who goes first rotates
             for kind in order:
+                settled = _settle(tree, 10.0)  # the last run's exits, Ray refilling its idle workers
                 s = distributed(task, kind, w, w * args.per_worker, rnd, ds(), tree)
                 samples.append(s)
                 if rnd == 0 and w == counts[0]:
                     print(f"  {kind} workers' niceness: {sorted(set(s.niceness))} (driver: {os.nice(0)})")
                 print(f"  round {rnd} {kind:<8} w={w:<2} start {s.start_s:5.2f} s  run {s.run_s:6.2f} s  "
                       f"{s.eps:6.3f} ep/s  episode cpu {1e3 * statistics.median(s.episode_cpu):4.0f} ms  "
-                      f"load {os.getloadavg()[0]:.2f}", flush=True)
+                      f"load {os.getloadavg()[0]:.2f}  (waited {settled:.1f} s for quiet before it)", flush=True)
     if len(kinds) > 1:
         import ray
 
