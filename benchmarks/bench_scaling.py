@@ -21,7 +21,7 @@ What a run measures, each part apart:
 * *start*: the pool's ``start()`` — workers started until every one has built its world — split
   into *boot* (asked → the worker begins opening the recipe: process creation, interpreter,
   imports, unpickling; a pool worker forks from a fork server that has imported robocfg, a Ray
-  actor is a fresh interpreter) and *build* (world, kinematic model, controllers), medians over
+  actor is a fresh interpreter, a kept one the process of an earlier run: *spawn* < 0) and *build* (world, kinematic model, controllers), medians over
   the workers;
 * *steady*: the episodes on those workers, ``episodes / run s``; *run s* is ``run()`` from its
   call to its return on the started workers — handing the batches out, the episodes, collecting
