@@ -15,10 +15,10 @@ episode and its size with the episode's would reach the limit (``>=``, lerobot's
 then it starts the next file. An episode larger than the limit gets a file of its own. Sizes are
 counted, not read back from disk, so where files are cut depends only on the episodes in order
 (a merge of workers' shards cuts where one process does): a data or metadata episode counts the
-Arrow size of its rows (the uncompressed size lerobot's ``get_parquet_file_size_in_mb`` counts;
-about the size on disk for image and depth frames, which parquet hardly compresses), a video
-episode the bytes of its own MP4 segment (lerobot adds the episode's MP4 file size to the
-current file's size the same way). 1 MB = 2**20 bytes, as lerobot's ``get_file_size_in_mb``.
+Arrow size of its rows (close to the uncompressed parquet size lerobot's ``aggregate_datasets``
+compares, ``get_parquet_file_size_in_mb``; lerobot's recorder compares the file's size on disk,
+which compressible data such as depth keeps below the count), a video episode the bytes of its
+own MP4 segment (lerobot adds the episode's MP4 file size to the current file's size the same way). 1 MB = 2**20 bytes, as lerobot's ``get_file_size_in_mb``.
 """
 
 from __future__ import annotations

@@ -14,8 +14,9 @@ Layout (``C`` chunk, ``F`` file: files roll over at lerobot's size limits, :mod:
 A new data file starts when the current one would reach ``data_files_size_in_mb`` with the next
 episode, a new video file (per camera) at ``video_files_size_in_mb``, a new chunk directory every
 ``chunks_size`` files (:class:`~robocfg.datasets.files.FileLimits`: lerobot 0.4.4's 100 MB, 200 MB
-and 1000 by default; a state-only run reaches 100 MB at about 600 000 frames, two 128x128 cameras'
-videos 200 MB at about 100 000).
+and 1000 by default; measured on the default pick-place at 20 Hz: state only, 100 MB of data rows
+every ≈ 520 000 frames, ≈ 4 400 episodes; a 128x128 depth camera, every ≈ 1 600 frames, ≈ 13
+episodes; a 128x128 camera's video, 200 MB every ≈ 2 000-2 800 episodes; docs/benchmarks.md).
 
 Depth (a camera with ``depth: true``) is a float32 feature ``observation.depth.<camera>`` of shape
 (H, W) in the data parquet, metres along the optical axis, stored exactly (a fixed-size list of
