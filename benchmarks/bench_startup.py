@@ -23,6 +23,11 @@ For each row: min / median / max wall time and the median CPU time of the child 
 what the wall time would be on an idle core). The machine's 1-minute load average is printed:
 on a shared 2-core machine other processes inflate the wall times, so read the min and CPU
 columns when the load is not ~0.
+
+``--against OTHER`` measures a second checkout in the same session (before / after a change):
+every sample of a row is taken in both, alternately, the order swapped each time, so both see the
+same load; each row is printed for ``--root`` and then for OTHER with the median of the paired
+CPU differences (OTHER − root).
 """
 
 from __future__ import annotations
@@ -81,10 +86,10 @@ def _set_root(root: Path) -> None:
     ROOT = root
 
 
-def _timed(argv: list[str]) -> tuple[float, float, str]:
+def _timed(argv: list[str], cwd: Path | None = None) -> tuple[float, float, str]:
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    out = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, check=True)
+    out = subprocess.run(argv, cwd=cwd or ROOT, capture_output=True, text=True, check=True)
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, out.stdout
@@ -99,21 +104,48 @@ def _row(label: str, wall: list[float], cpu: list[float], goal: float | None) ->
             "cpu_median_s": statistics.median(cpu), "goal_s": goal}
 
 
-def _first_episode(runs: int) -> list[dict]:
+def _first_episode(runs: int, roots: list[Path]) -> dict[Path, tuple[dict, dict]]:
+    """root → (wall, CPU) samples of each mark, the roots taking turns (order swapped each run)."""
     argv = [sys.executable, "-c", _FIRST]
-    _timed(argv)  # warm-up
-    wall: dict[str, list[float]] = {m: [] for m in (*FIRST_MARKS, "episode 1 alone")}
-    cpu: dict[str, list[float]] = {m: [] for m in wall}
-    for _ in range(runs):
-        t0 = time.time()
-        _, _, out = _timed(argv)
-        marks = json.loads(out.strip().splitlines()[-1])
-        for m in FIRST_MARKS:
-            wall[m].append(marks[m][0] - t0)
-            cpu[m].append(marks[m][1])
-        wall["episode 1 alone"].append(marks["episode 1"][0] - marks["episode 0"][0])
-        cpu["episode 1 alone"].append(marks["episode 1"][1] - marks["episode 0"][1])
-    return [_row(f"first-episode: {m}", wall[m], cpu[m], FIRST_GOAL.get(m)) for m in wall]
+    names = (*FIRST_MARKS, "episode 1 alone")
+    out: dict[Path, tuple[dict, dict]] = {r: ({m: [] for m in names}, {m: [] for m in names}) for r in roots}
+    for r in roots:
+        _timed(argv, r)  # warm-up
+    for i in range(runs):
+        for r in roots if i % 2 == 0 else roots[::-1]:
+            wall, cpu = out[r]
+            t0 = time.time()
+            _, _, stdout = _timed(argv, r)
+            marks = json.loads(stdout.strip().splitlines()[-1])
+            for m in FIRST_MARKS:
+                wall[m].append(marks[m][0] - t0)
+                cpu[m].append(marks[m][1])
+            wall["episode 1 alone"].append(marks["episode 1"][0] - marks["episode 0"][0])
+            cpu["episode 1 alone"].append(marks["episode 1"][1] - marks["episode 0"][1])
+    return out
+
+
+def _samples(argv: list[str], runs: int, roots: list[Path]) -> dict[Path, tuple[list, list]]:
+    out: dict[Path, tuple[list, list]] = {r: ([], []) for r in roots}
+    for r in roots:
+        _timed(argv, r)  # warm-up (file cache, bytecode)
+    for i in range(runs):
+        for r in roots if i % 2 == 0 else roots[::-1]:
+            wall, cpu, _ = _timed(argv, r)
+            out[r][0].append(wall)
+            out[r][1].append(cpu)
+    return out
+
+
+def _rows(label: str, samples: dict[Path, tuple[list, list]], goal: float | None) -> list[dict]:
+    roots = list(samples)
+    rows = [_row(label, *samples[roots[0]], goal)]
+    if len(roots) == 2:
+        base_cpu, cpu = samples[roots[0]][1], samples[roots[1]][1]
+        diff = statistics.median([b - a for a, b in zip(base_cpu, cpu, strict=True)])
+        rows.append(_row(f"  vs --against ({diff:+.3f})", *samples[roots[1]], goal))
+        rows[-1].update(row=f"{label} (against)", checkout=str(roots[1]), cpu_paired_diff_median_s=diff)
+    return rows
 
 
 def main() -> None:
@@ -122,24 +154,28 @@ def main() -> None:
     ap.add_argument("--only", default="", help="comma-separated rows (default: all), e.g. help,first-episode")
     ap.add_argument("--json", type=Path, default=None, help="write the rows here")
     ap.add_argument("--root", type=Path, default=ROOT, help="the checkout to measure (default: this one)")
+    ap.add_argument("--against", type=Path, default=None,
+                    help="a second checkout measured in the same session, alternating with --root")
     args = ap.parse_args()
     _set_root(args.root.resolve())
+    roots = [ROOT] + ([args.against.resolve()] if args.against is not None else [])
     only = [s for s in args.only.split(",") if s] or [*CASES, "first-episode"]
     unknown = set(only) - {*CASES, "first-episode"}
     if unknown:
         sys.exit(f"unknown rows: {', '.join(sorted(unknown))}")
     print(f"load average before: {os.getloadavg()[0]:.2f}   runs: {args.runs}   python: {sys.version.split()[0]}   "
-          f"root: {ROOT}")
+          f"root: {ROOT}" + (f"   against: {roots[1]}" if len(roots) == 2 else ""))
     print(f"{'row':<26}{'min s':>8}{'median s':>10}{'max s':>8}{'CPU s':>8}{'goal s':>8}  ok")
     rows = []
     for label in only:
         if label == "first-episode":
-            rows += _first_episode(args.runs)
+            first = _first_episode(args.runs, roots)
+            for m in (*FIRST_MARKS, "episode 1 alone"):
+                rows += _rows(f"first-episode: {m}", {r: (w[m], c[m]) for r, (w, c) in first.items()},
+                              FIRST_GOAL.get(m))
             continue
         argv, goal = CASES[label]
-        _timed(argv)  # warm-up
-        samples = [_timed(argv)[:2] for _ in range(args.runs)]
-        rows.append(_row(label, [w for w, _ in samples], [c for _, c in samples], goal))
+        rows += _rows(label, _samples(argv, args.runs, roots), goal)
     load = os.getloadavg()[0]
     print(f"load average after: {load:.2f}")
     if args.json is not None:
