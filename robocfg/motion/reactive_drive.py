@@ -4,7 +4,7 @@ Pick-place's ``motion: reactive`` drives its free-space moves (pre-grasp, transp
 :class:`~robocfg.motion.reactive.ReactiveController`: every control period the target EE pose is
 converted to the TCP pose the controller servos to, the controller's joint positions and
 velocities go to the drives, and the arm keeps ``margin`` m from the task's scene (ground, table,
-pedestal, ``scene.obstacles``). Building the controller loads the URDF into placo and convex-hulls
+pedestal, ``scene.obstacles`` and fixtures; mesh bodies as the convex hulls the planner sees). Building the controller loads the URDF into placo and convex-hulls
 every collision mesh: build it once per run with :func:`build_reactive_drive`.
 
 A held object is not part of the task scene, so it would be dragged over or into obstacles: give
@@ -38,7 +38,7 @@ class ReactiveDrive:
     controller: ReactiveController
     substeps: int
     T_ee_tcp: np.ndarray
-    skipped: list[str]  # scene bodies the controller cannot avoid (meshes)
+    skipped: list[str]  # scene bodies the controller cannot avoid (none since meshes are convex hulls)
 
 
 def bounding_radius(body: Body) -> float:
@@ -63,7 +63,7 @@ def build_reactive_drive(robot: CheckedRobot, world: World, arm_name: str, veloc
     from robocfg.collision import LinkGeometry
     from robocfg.config.types import AXIS_INDEX
     from robocfg.motion.reactive import ReactiveController, ReactiveSettings
-    from robocfg.motion.reactive.setup import arm_spec, scene_shapes
+    from robocfg.motion.reactive.setup import MeshPoses, arm_spec, scene_shapes
     from robocfg.sim.loading import prepared_urdf
 
     substeps = max(1, round(1.0 / (rate * world.dt)))
@@ -74,6 +74,6 @@ def build_reactive_drive(robot: CheckedRobot, world: World, arm_name: str, veloc
         origin[AXIS_INDEX[arm_cfg.ee_axis], 3] = arm_cfg.tcp_offset + payload[0]
         held = LinkGeometry(arm_cfg.ee_link, "sphere", origin, (payload[1],))
         spec = replace(spec, collision=[*(spec.collision or []), held])
-    env, skipped = scene_shapes(world.task.config.scene)
+    env, skipped = scene_shapes(world.task.config.scene, MeshPoses.of(world))
     settings = ReactiveSettings(dt=substeps * world.dt, margin=margin, max_linear_speed=max_speed)
     return ReactiveDrive(ReactiveController(spec, env, settings), substeps, np.asarray(spec.T_ee_tcp, float), skipped)

@@ -97,11 +97,11 @@ class FollowLoop:
 
     def _controller(self, obstacles: list[FollowObstacle]) -> Any:
         from robocfg.motion.reactive import EscapeSettings, ReactiveController, ReactiveSettings
-        from robocfg.motion.reactive.setup import arm_spec, body_shape, scene_shapes
+        from robocfg.motion.reactive.setup import MeshPoses, arm_spec, body_shape, scene_shapes
         from robocfg.sim.loading import prepared_urdf
 
         p, checked = self.params, self.task.robots[0]
-        env, skipped = scene_shapes(self.task.config.scene)
+        env, skipped = scene_shapes(self.task.config.scene, MeshPoses.of(self.world))
         for name in skipped:
             self.result.warnings.append(f"obstacle {name!r} is a mesh: the controller does not avoid it (only measured)")
         for ob in obstacles:

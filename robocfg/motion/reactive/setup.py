@@ -1,16 +1,19 @@
 """Build the controller's inputs from config: the arm (limits, TCP, mount) and the environment shapes.
 
-Frames: world, 4×4 transforms, metres. Pure numpy + config (no PyBullet).
+Frames: world, 4×4 transforms, metres. Pure numpy + config (no PyBullet; a world is only asked
+where its mesh bodies are).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robocfg.collision import EnvShape, robot_geometry
+from robocfg.collision.bodies import body_env_shape
 from robocfg.config.commands import FollowObstacle
 from robocfg.config.scene import Body, Scene
 from robocfg.config.types import AXIS_INDEX
@@ -19,6 +22,7 @@ from robocfg.motion.reactive.controller import ArmSpec
 
 if TYPE_CHECKING:
     from robocfg.checks.robot import CheckedRobot
+    from robocfg.sim.world import World
 
 DEFAULT_VELOCITY = 2.0  # rad/s for joints whose URDF gives no velocity limit
 
@@ -70,9 +74,11 @@ def body_shape(body: Body | FollowObstacle, obstacle: bool = True) -> EnvShape |
     return EnvShape(body.name, body.shape, tuple(body.size), pose_matrix(body), obstacle)
 
 
-def scene_shapes(scene: Scene) -> tuple[list[EnvShape], list[str]]:
+def scene_shapes(scene: Scene, meshes: MeshPoses | None = None) -> tuple[list[EnvShape], list[str]]:
     """(environment shapes, names of bodies left out) for the ground, table, pedestal, obstacles and
-    fixture parts.
+    fixture parts. A mesh or URDF obstacle is the convex hull of its collision geometry
+    (:func:`robocfg.collision.bodies.body_env_shape`, as the planner and the clutter filter see
+    it) where ``meshes`` puts it; without ``meshes`` it is left out (named in the second list).
     Movable ``objects`` are not avoided (the robot may touch them)."""
     shapes: list[EnvShape] = []
     skipped: list[str] = []
@@ -88,8 +94,32 @@ def scene_shapes(scene: Scene) -> tuple[list[EnvShape], list[str]]:
         shapes.append(EnvShape("pedestal", "cylinder", (scene.pedestal.radius, scene.pedestal.height), T, obstacle=False))
     for ob in [*scene.obstacles, *scene.fixture_parts()]:
         s = body_shape(ob)
+        if s is None and meshes is not None:
+            s = body_env_shape(ob, meshes.pose(ob), meshes.base_dir)
         if s is None:
             skipped.append(ob.name)
         else:
             shapes.append(s)
     return shapes, skipped
+
+
+class MeshPoses:
+    """Where mesh bodies are for :func:`scene_shapes`: ``pose(body)`` (4×4, world) of the body frame
+    the convex hull's vertices are given in (the frame PyBullet reports, ``World.body_pose``: for
+    a URDF its root link's inertial frame); ``base_dir`` resolves relative mesh paths (the task
+    file's folder)."""
+
+    def __init__(self, base_dir: Path, pose: Callable[[Body], np.ndarray]):
+        self.base_dir, self.pose = Path(base_dir), pose
+
+    @classmethod
+    def of(cls, world: World) -> MeshPoses:
+        """Mesh bodies where ``world`` has them (as written in the task when not spawned)."""
+        from robocfg.geometry import pose_to_matrix
+
+        def pose(body: Body) -> np.ndarray:
+            if body.name in world.bodies:
+                return pose_to_matrix(*world.body_pose(body.name))
+            return pose_matrix(body)
+
+        return cls(world.task.path.parent, pose)
