@@ -36,6 +36,7 @@ from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
 from robocfg.runners.pick_place_many_command import PickPlaceManyCommand
 from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch, ObjectMachine, Spot
 from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
+from robocfg.runners.pick_place_many_spot import BinWalls
 from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
 
 if TYPE_CHECKING:
@@ -60,8 +61,9 @@ def object_params(params: PickPlaceManyParams, body: Body, place_xy: np.ndarray)
         max_tilt_deg=params.max_tilt_deg)
 
 
-def spots_for(task, params: PickPlaceManyParams) -> list[Spot]:
-    """The place spots the objects take, in order (one per object)."""
+def spots_for(task, params: PickPlaceManyParams, spare: bool = False) -> list[Spot]:
+    """The place spots the objects take, in order (one per object; ``spare``: every spot the
+    target holds, the first ones those)."""
     from robocfg.checks.clutter import footprint_radius, place_fixture, place_spots
     from robocfg.config.fixtures import ShelfFixture
 
@@ -70,14 +72,17 @@ def spots_for(task, params: PickPlaceManyParams) -> list[Spot]:
     spots = place_spots(scene, params.place, radius)
     f = place_fixture(scene, params.place)
     to_front = params.place.depth * (f.size[0] - f.board) if isinstance(f, ShelfFixture) else 0.0
-    return [Spot(float(p[2]), spots.front, to_front, spots.ceiling) for p in spots.points[: len(params.objects)]]
+    points = spots.points if spare else spots.points[: len(params.objects)]
+    return [Spot(float(p[2]), spots.front, to_front, spots.ceiling) for p in points]
 
 
-def spot_points(task, params: PickPlaceManyParams) -> np.ndarray:
+def spot_points(task, params: PickPlaceManyParams, spare: bool = False) -> np.ndarray:
+    """Centres (k, 3; m, world) of the spots of :func:`spots_for`."""
     from robocfg.checks.clutter import footprint_radius, place_spots
 
     radius = max(footprint_radius(o, task.path.parent) for o in params.objects)
-    return place_spots(task.config.scene, params.place, radius).points[: len(params.objects)]
+    points = place_spots(task.config.scene, params.place, radius).points
+    return points if spare else points[: len(params.objects)]
 
 
 class ManySession(EpisodeSession[ManyEpisode]):
@@ -105,8 +110,10 @@ class ManySession(EpisodeSession[ManyEpisode]):
         self.handle = self.world.robot.arm(self.arm_cfg.name)
         self.bodies = [as_body(o) for o in self.params.objects]
         self.shapes = [object_shape(b, self.task.path.parent) for b in self.bodies]
-        self.spots = spots_for(self.task, self.params)
-        self.spot_xy = spot_points(self.task, self.params)[:, :2]
+        # every spot of the target: the first ones in order, the rest spare (a spot where the open
+        # hand cannot clear a bin's walls gives way to the next free one)
+        self.spots = spots_for(self.task, self.params, spare=True)
+        self.spot_xy = spot_points(self.task, self.params, spare=True)[:, :2]
         model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
         bound_ik_by_iterations(model)
         scale = self.params.speed_scale
@@ -117,8 +124,19 @@ class ManySession(EpisodeSession[ManyEpisode]):
             planned = build_planned_drive(robot, self.world, model, objects=self.bodies)
         self.tools = _Tools(model, limits, None, planned, boxes=boxes, pad_force=pad_force(robot, self.arm_cfg))
         self.clutter = build_planned_drive(robot, self.world, model, margin=self.params.clutter_margin, objects=self.bodies)
+        self.walls = self._bin_walls(model)
         scene = self.task.config.scene
         self.parts = [b.name for b in [*scene.obstacles, *scene.fixture_parts()]]
+
+    def _bin_walls(self, model) -> BinWalls | None:
+        """The target bin's walls around the arm (None for a shelf)."""
+        from robocfg.checks.clutter import place_fixture
+        from robocfg.config.fixtures import BinFixture
+
+        scene = self.task.config.scene
+        if not isinstance(place_fixture(scene, self.params.place), BinFixture):
+            return None
+        return BinWalls.build(self.task.robots[0], model, scene, self.params.place.fixture)
 
     def _machines(self, k: int, recorder: FrameRecorder | None,
                   on_step: Callable[[], None] | None) -> dict[str, ObjectMachine]:
@@ -139,7 +157,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
             machines[body.name] = ObjectMachine(
                 self.world, self.handle, tools, object_params(self.params, body, self.spot_xy[0]), setup, recorder,
                 self.log_for(k), body_id=bid, clutter=clutter, spot=self.spots[0], on_step=on_step,
-                place_clearance=self.params.place_clearance)
+                place_clearance=self.params.place_clearance, walls=self.walls)
         return machines
 
     def _instruction(self) -> str:
@@ -161,13 +179,14 @@ class ManySession(EpisodeSession[ManyEpisode]):
         first.mover.settle(0.2)
         starts = {n: m.world.body_pose(m.obj) for n, m in machines.items()}
         remaining, order = list(machines), list[str]()
+        free = list(range(len(self.spot_xy)))  # spots not taken yet, in order
         failure: tuple[str, str, str] | None = None
         while remaining and failure is None:
-            turn = len(order)
             for n in remaining:
-                machines[n].assign(self.spot_xy[turn], self.spots[turn])
+                machines[n].assign(self.spot_xy[free[0]], self.spots[free[0]])
             name = self._next(machines, remaining)
             m = machines[name]
+            m.spare_xy = [self.spot_xy[i] for i in free[1:]]
             current[:] = [m]
             order.append(name)
             remaining.remove(name)
@@ -176,6 +195,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
             except MoveFailed as exc:
                 m.close_phase(False, exc.reason)
                 failure = (name, exc.phase, exc.reason)
+            free.remove(min(free, key=lambda i: float(np.linalg.norm(self.spot_xy[i] - m.setup.place_xy))))
         records = [self._record(machines[b.name], b.name in order, starts[b.name], failure) for b in self.bodies]
         return ManyEpisode(
             index=k, seed=self.seed + k, success=failure is None, failed_phase=failure[1] if failure else None,
@@ -192,7 +212,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
         def judge() -> tuple[bool, str]:
             """Every object at rest on its own place spot (the nearest unused one, in the task's
             order), upright: the run's final check of each object."""
-            free = list(range(len(machines)))
+            free = list(range(len(self.spot_xy)))
             for name, m in machines.items():
                 xy = self.world.body_pose(m.obj)[0][:2]
                 j = min(free, key=lambda i: float(np.linalg.norm(self.spot_xy[i] - xy)))

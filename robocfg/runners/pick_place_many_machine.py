@@ -8,7 +8,9 @@ for an object already lying in a scene full of others, with two changes:
   ``clutter_margin`` from the neighbouring objects, the fixtures and the obstacles
   (:class:`ClutterFilter`, pinocchio + coal on the robot's collision model; the object itself is
   left out). Among the kept ones the choice is pick-place's (least joint travel);
-* **the place spot**: a bin spot is approached from ``lift_height`` above and left straight up; a
+* **the place spot**: a bin spot is approached from ``lift_height`` above and left straight up,
+  the hand turned about the object's vertical (or the object sent to a spare spot) so that the
+  open hand clears the bin's walls (:mod:`.pick_place_many_spot`); a
   shelf spot is entered ``place_clearance`` above its board (the planner finds the way in through
   the open front), lowered onto (the hand goes on down until the board carries the object:
   ``SET_DOWN_PRESS``), and left by lifting back to that height and withdrawing out of the front
@@ -37,6 +39,7 @@ from robocfg.runners.pick_place_machine import RELEASE_CLEARANCE, SETTLE_POLL, _
 
 if TYPE_CHECKING:
     from robocfg.planning.drive import PlannedDrive
+    from robocfg.runners.pick_place_many_spot import BinWalls
     from robocfg.sim.world import World
 
 CARRIED_OFF = 0.01  # m: a released object that rises this much during the retract went with the fingers
@@ -134,7 +137,8 @@ class ObjectMachine(_StateMachine):
     already spawned; ``clutter``: the grasp filter (None: no filter); ``spot``: the place spot."""
 
     def __init__(self, world, arm, tools, params, setup, recorder, log, *, body_id: int, clutter: ClutterFilter | None,
-                 spot: Spot, on_step: Callable[[], None] | None = None, place_clearance: float = 0.03):
+                 spot: Spot, on_step: Callable[[], None] | None = None, place_clearance: float = 0.03,
+                 walls: BinWalls | None = None):
         self._extra_step = on_step
         super().__init__(world, arm, tools, params, setup, recorder, log, body_id=body_id)
         self.clutter, self.spot, self.place_clearance = clutter, spot, place_clearance
@@ -142,6 +146,9 @@ class ObjectMachine(_StateMachine):
         self.cost = math.inf  # joint travel (rad) of the chosen grasp
         self.candidates = 0
         self.rejected: list[str] = []  # what each candidate dropped for a collision hit (first pair)
+        self.walls = walls  # a bin target's walls (None: no hand-clearance choice, e.g. a shelf)
+        self.spare_xy: list[np.ndarray] = []  # free place spots (x, y, m) to fall back on, in order
+        self.place_turn_deg = 0.0  # the hand's turn (deg) about the object's vertical at the place
 
     @property
     def in_collision(self) -> int:
@@ -222,12 +229,14 @@ class ObjectMachine(_StateMachine):
         T_place[:3, 3] = np.array([*self.setup.place_xy, place_z]) + offset
         shelf = self.spot.ceiling is not None
         rise = self.place_clearance if shelf else p.lift_height
-        T_above = _shifted(T_place, [0, 0, rise])
-        if not shelf:
-            T_above[2, 3] = max(T_lift[2, 3], T_above[2, 3])
         if self.planned is not None:
             self._attach_held()
         self.begin("transport", "carry above the place spot")
+        if not shelf and self.walls is not None:
+            T_place = self._clear_of_walls(self.walls, T_place, max(rise, p.above_height, T_lift[2, 3] - T_place[2, 3]))
+        T_above = _shifted(T_place, [0, 0, rise])
+        if not shelf:
+            T_above[2, 3] = max(T_lift[2, 3], T_above[2, 3])
         self._free_move(T_above, check=self._dropped, lines=(T_place,))
         self.begin("lower", "lower onto the support")
         self.mover.move(T_place, straight=True, check=self._dropped)
@@ -253,6 +262,19 @@ class ObjectMachine(_StateMachine):
         self.close_phase(True)
         self.mover.settle(0.3)
         self._check_placed()
+
+    def _clear_of_walls(self, walls: BinWalls, T_place: np.ndarray, top: float) -> np.ndarray:
+        """The EE place pose at the assigned spot, or the first spare one (``spare_xy``), turned
+        the least about the object's vertical so the open hand clears the bin's walls up to
+        ``top`` m above it (:mod:`.pick_place_many_spot`); the spot taken becomes ``place_xy``."""
+        spots = [self.setup.place_xy, *self.spare_xy]
+        choice = walls.choose(self.mover, T_place, self.setup.place_xy, spots, top, self.arm.joint_positions())
+        if choice.turn_deg or not np.allclose(choice.xy, self.setup.place_xy):
+            self.log(f"  place: spot [{choice.xy[0]:.3f}, {choice.xy[1]:.3f}] m, hand turned {choice.turn_deg:+.0f}° "
+                     f"to keep the open hand clear of {walls.fixture!r}'s walls")
+        self.setup = dataclasses.replace(self.setup, place_xy=choice.xy)
+        self.place_turn_deg = choice.turn_deg
+        return choice.T_place
 
     def _set_down(self) -> None:
         """Lower the hand (straight down, m) until the held object's lowest point is

@@ -1,0 +1,116 @@
+"""Where, and turned how far, an object is put into a bin so that the open hand clears the walls.
+
+The place spots (:func:`robocfg.checks.clutter.place_spots`) keep the *object's* footprint
+``gap`` from a bin's walls; the hand around it is wider (a Panda hand is 0.2 m across its closing
+axis, the open fingers 0.1 m) and, for an object grasped low, comes down below the walls' tops: a
+duck placed 9 cm from a wall pressed the Panda's hand into it while lowering. So before the
+transport the hand's turn about the vertical through the object's centre (the object turns with
+it) is chosen such that the arm and the gripper, fingers open (the release width: the kinematic
+model holds the gripper open), keep ``WALL_MARGIN`` from the bin's walls at the place pose and all
+along the straight line up to the highest pose the lower starts from or the retract ends at —
+tested with pinocchio + coal on the robot's own collision geometry
+(:class:`~robocfg.planning.checker.CollisionChecker` holding the walls only). The turn nearest
+zero is taken (turning by 0 changes nothing); a spot where no turn fits gives way to the next free
+spot; when none fits anywhere the phase fails naming what the hand would touch.
+
+Frames: world, 4×4, metres; turns in degrees about the world's z axis.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robocfg.motion.moves import MoveFailed
+
+if TYPE_CHECKING:
+    from robocfg.checks.robot import CheckedRobot
+    from robocfg.config.scene import Scene
+    from robocfg.kinematics.model import KinematicModel
+    from robocfg.motion.moves import ArmMover
+    from robocfg.planning.checker import CollisionChecker
+
+WALL_MARGIN = 0.01  # m the open hand and the arm keep from a bin's walls (the planner's margin)
+# turns (deg) tried, nearest first; a parallel gripper turned by 180° is the same hand
+TURNS_DEG = (0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 60.0, -60.0, 75.0, -75.0, 90.0)
+
+
+def turned(T: np.ndarray, centre_xy: np.ndarray, deg: float) -> np.ndarray:
+    """``T`` (4×4, world) turned by ``deg`` about the vertical through ``centre_xy`` (m)."""
+    a = math.radians(deg)
+    Rz = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    out = T.copy()
+    out[:3, :3] = Rz @ T[:3, :3]
+    c = np.array([centre_xy[0], centre_xy[1], 0.0])
+    out[:3, 3] = c + Rz @ (T[:3, 3] - c)
+    out[2, 3] = T[2, 3]
+    return out
+
+
+@dataclass(frozen=True)
+class PlaceChoice:
+    """A spot's centre (x, y, m), the turn (deg) and the EE place pose (4×4, world) taken."""
+
+    xy: np.ndarray
+    turn_deg: float
+    T_place: np.ndarray
+
+
+class BinWalls:
+    """The walls of the bin the objects go into, as a collision model of the arm with the gripper
+    open among them (see the module doc)."""
+
+    def __init__(self, checker: CollisionChecker, fixture: str):
+        self.checker, self.fixture = checker, fixture
+
+    @classmethod
+    def build(cls, robot: CheckedRobot, kin: KinematicModel, scene: Scene, fixture: str) -> BinWalls:
+        """Walls (every part but the floor) of bin ``fixture`` of ``scene`` around the arm of ``kin``."""
+        from robocfg.collision import robot_geometry
+        from robocfg.motion.reactive.setup import scene_shapes
+        from robocfg.planning.checker import CollisionChecker
+
+        links, _ = robot_geometry(robot)
+        env, _ = scene_shapes(scene)
+        walls = [e for e in env if e.name.startswith(f"{fixture}/") and e.name != f"{fixture}/floor"]
+        return cls(CollisionChecker(kin, links, walls, WALL_MARGIN), fixture)
+
+    def hits(self, mover: ArmMover, T_place: np.ndarray, top: float, q0: np.ndarray) -> str | None:
+        """What the arm touches (within the margin) at ``T_place`` or on the straight line up to
+        height ``top`` (m) above it; None when it is clear. IK seeded from ``q0``; an unreachable
+        line counts as a hit (named)."""
+        T_top = T_place.copy()
+        T_top[2, 3] += top
+        try:
+            q = mover.solve(T_place, q0)
+            line = mover.straight_waypoints(q, T_top)
+        except MoveFailed as exc:
+            return exc.reason
+        for qi in line:
+            if not self.checker.is_valid(qi):
+                hit = self.checker.contacts(qi)
+                return hit[0].describe() if hit else "a wall within the margin"
+        return None
+
+    def choose(self, mover: ArmMover, T_place: np.ndarray, obj_xy: np.ndarray, spots: list[np.ndarray],
+               top: float, q0: np.ndarray) -> PlaceChoice:
+        """The first of ``spots`` (x, y, m; in order) with the least turn that clears the walls.
+        ``T_place``: the EE place pose with the object's centre at ``obj_xy``, untuned."""
+        misses: list[str] = []
+        for xy in spots:
+            shift = np.array([xy[0] - obj_xy[0], xy[1] - obj_xy[1], 0.0])
+            T_at = T_place.copy()
+            T_at[:3, 3] += shift
+            for deg in TURNS_DEG:
+                T = turned(T_at, np.asarray(xy, float), deg)
+                why = self.hits(mover, T, top, q0)
+                if why is None:
+                    return PlaceChoice(np.asarray(xy, float), deg, T)
+                if deg == 0.0:
+                    misses.append(f"[{xy[0]:.3f}, {xy[1]:.3f}]: {why}")
+        raise MoveFailed(mover.phase, f"no place spot in {self.fixture!r} keeps the open hand "
+                                      f"{WALL_MARGIN * 1000:.0f} mm clear of its walls at any turn "
+                                      f"(unturned: {'; '.join(misses)})")

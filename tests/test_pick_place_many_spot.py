@@ -1,0 +1,87 @@
+"""Bin place spots keep the open hand clear of the walls (issue 18): the hand is turned about the
+object's vertical, or the object goes to a spare spot, so that the arm and the gripper with its
+fingers open keep a margin from the bin's walls (``robocfg.runners.pick_place_many_spot``)."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+import yaml
+
+from robocfg.checks import load_task
+from robocfg.config import catalog
+from robocfg.engine import RunOptions, open_session
+from robocfg.errors import PhaseFailed
+from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
+from robocfg.motion.moves import ArmMover
+from robocfg.runners.pick_place_many_spot import WALL_MARGIN, turned
+
+DUCK = {"name": "duck", "shape": "mesh", "mesh": "pybullet_data://duck_vhacd.urdf", "size": [0.6, 0.6, 0.6],
+        "position": [0.55, -0.10, 0.117], "euler_deg": [0, 0, 0], "mass": 0.1, "color": [0.9, 0.8, 0.1, 1.0],
+        "region": {"xy_range": [0.004, 0.004], "yaw_range_deg": 10.0}}
+
+
+@pytest.fixture(scope="module")
+def duck_task(tmp_path_factory):
+    """clear_table with red, blue and a pybullet_data duck (scale 0.6) on the table, into the bin.
+    Before the hand's clearance was chosen, seed 0 episode 0 pressed the Panda's hand into the
+    bin's +x wall while lowering the duck (74 contact polls, 'lower: duck: did not converge')."""
+    data = copy.deepcopy(yaml.safe_load(catalog.find("tasks", "clear_table").read_text()))
+    objs = data["pick_place_many"]["objects"]
+    data["pick_place_many"]["objects"] = [objs[0], DUCK, objs[2]]
+    path = tmp_path_factory.mktemp("duck") / "clear_table_duck.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return load_task(path)
+
+
+def test_a_duck_goes_into_the_bin_without_the_robot_touching_the_bin(duck_task):
+    lines: list[str] = []
+    with open_session(duck_task, RunOptions(seed=0, log=lines.append)) as session:
+        record = session.run(0)
+    assert record.success, record.reason
+    assert record.robot_fixture_contacts == 0, record.contacts_by_kind
+    duck = next(o for o in record.objects if o.name == "duck")
+    assert duck.success and duck.place_error is not None and duck.place_error < 0.02
+    # the duck's spot by the +x wall needed the hand turned (or another spot): the choice acted
+    assert any("to keep the open hand clear of 'bin'" in line for line in lines), lines
+
+
+def _near_wall(session, inset: float) -> tuple[np.ndarray, np.ndarray]:
+    """A top-down EE place pose with the fingers closing along x, the TCP 3 cm above the bin's
+    floor, ``inset`` m inside the bin's +x wall on the bin's centre line; and the spot (x, y)."""
+    bin_ = next(f for f in session.task.config.scene.fixtures if f.name == "bin")
+    x_wall = bin_.position[0] + bin_.size[0] / 2 - bin_.wall
+    xy = np.array([x_wall - inset, bin_.position[1]])
+    z = bin_.position[2] + bin_.wall + 0.03
+    R = grasp_rotation(np.array([0.0, 0.0, -1.0]), np.array([1.0, 0.0, 0.0]))
+    return ee_pose_from_grasp(Grasp(np.array([*xy, z]), R, 0.05), session.arm_cfg), xy
+
+
+def test_the_hand_turns_to_clear_a_wall_and_a_spot_where_no_turn_fits_is_refused(duck_task):
+    """At a spot 6 cm inside a wall the open Panda hand, closing towards the wall, reaches into it;
+    turned, it clears it by the margin (pinocchio + coal on the robot's collision model). 2 cm
+    inside the wall no turn fits: refused naming the bin."""
+    with open_session(duck_task, RunOptions(seed=0)) as session:
+        walls = session.walls
+        assert walls is not None and walls.fixture == "bin"
+        mover = ArmMover(session.world, session.handle, session.tools.model, session.tools.limits, phase="transport")
+        q0 = np.asarray(session.arm_cfg.home, float)
+        T, xy = _near_wall(session, 0.06)
+        hit = walls.hits(mover, T, 0.12, q0)
+        assert hit is not None and "bin/wall_+x" in hit, hit
+        choice = walls.choose(mover, T, xy, [xy], 0.12, q0)
+        assert choice.turn_deg != 0.0 and np.allclose(choice.xy, xy)
+        assert np.allclose(choice.T_place, turned(T, xy, choice.turn_deg))
+        assert walls.hits(mover, choice.T_place, 0.12, q0) is None
+        q = mover.solve(choice.T_place, q0)
+        assert walls.checker.clearance(q) >= WALL_MARGIN
+        # a spare spot is taken when the first cannot be cleared at any turn
+        T1, xy1 = _near_wall(session, 0.02)
+        spare = walls.choose(mover, T1, xy1, [xy1, xy], 0.12, q0)
+        assert np.allclose(spare.xy, xy)
+        with pytest.raises(PhaseFailed) as exc:
+            walls.choose(mover, T1, xy1, [xy1], 0.12, q0)
+        assert exc.value.phase == "transport"
+        assert "no place spot in 'bin' keeps the open hand 10 mm clear of its walls" in exc.value.reason
