@@ -201,12 +201,16 @@ class _StateMachine(GraspChoice):
                  f"be accelerated up to {a:.1f} m/s²")
 
     def _release(self) -> None:
-        """Open until the object is free and the fingers are 90 % open. Fingers that stop short of
-        open (``RELEASE_STALL`` s without moving) while the object is still between them get their
-        contacts with it rebuilt from the geometry (:meth:`~robocfg.sim.gripper.base.Gripper.refresh_contacts`:
-        PyBullet can keep a contact point whose normal turned round, which holds them shut), and
-        so do fingers open but still touching it, before the hand moves away (such a point drags
-        the object up with them)."""
+        """Open until the object is free and the fingers are 90 % open. Opening rebuilds the
+        fingers' contacts with what they touch (:meth:`robocfg.sim.gripper.parallel.ParallelGripper.open`:
+        PyBullet can keep a contact point whose normal turned round, which drags the object with
+        an opening finger or holds the fingers shut; done where the command reaches the drives,
+        so a dataset replay does it at the same step). As a last resort, not replayed (an episode
+        where it fires does not replay bit-exactly, and the log says so): fingers that still stop
+        short of open (``RELEASE_STALL`` s without moving) while the object is between them get
+        their contacts with it rebuilt again (:meth:`~robocfg.sim.gripper.base.Gripper.refresh_contacts`),
+        and so do fingers open but still touching it, before the hand moves away (such a point
+        drags the object up with them)."""
         t0 = self.world.t
         self.gripper.open()
         last, still = self.gripper.fraction(), 0.0
@@ -218,10 +222,12 @@ class _StateMachine(GraspChoice):
             still = still + SETTLE_POLL * self.world.dt if abs(now - last) < RELEASE_STILL else 0.0
             last = now
             if still >= RELEASE_STALL and self.gripper.refresh_contacts(self.obj):
-                self.log(f"  release: the fingers stopped at {now:.0%} open; their contacts with the object rebuilt")
+                self.log(f"  release: the fingers stopped at {now:.0%} open; their contacts with the object rebuilt "
+                         "(not replayed by a dataset replay)")
                 still = 0.0
         if self.gripper.refresh_contacts(self.obj, touching_only=True):
-            self.log("  release: a finger still touched the object when open; its contacts rebuilt")
+            self.log("  release: a finger still touched the object when open; its contacts rebuilt (not replayed by "
+                     "a dataset replay)")
 
     def _dropped(self) -> str | None:
         if self._held():

@@ -64,7 +64,25 @@ class ParallelGripper(Gripper):
 
     # ---- commands (non-blocking) -----------------------------------------------------------
     def open(self) -> None:
+        """Open (non-blocking). Opening from a closing or closed command is a release: first the
+        fingers' contacts with every body they touch are rebuilt from the geometry as it is
+        (:meth:`robocfg.sim.queries.SceneQueries.refresh_contacts`): PyBullet keeps contact points
+        across steps, and one kept from the carry whose normal has turned round (a fingertip corner
+        in the object's face) drags the object with an opening finger (measured on the Panda
+        shelf: 10 mm sideways) or holds the fingers shut. Done here, where the command reaches the
+        drives, so a dataset replay (whose command gate sends the recorded open at the same
+        physics step) rebuilds them at the same step."""
+        if self._goal < 1.0:
+            for body in self._touched():
+                self.world.refresh_contacts(self.robot.body_id, body, self.fingers)
         self.set_fraction(1.0)
+
+    def _touched(self) -> list[int]:
+        """Bodies (ids, ascending) other than the robot that a finger link touches (a contact point
+        of the last step at distance ≤ 0)."""
+        me, c = self.robot.body_id, self.client
+        return sorted({int(k[2]) for f in self.fingers for k in p.getContactPoints(me, linkIndexA=f, physicsClientId=c)
+                       if k[2] != me and k[8] <= 0.0})
 
     def close(self) -> None:
         self.set_fraction(0.0)
