@@ -1,8 +1,9 @@
-"""Several-object tasks (issue 18) on several robots: bin-to-bin with five objects, shelf placing
-and clear-table, ``run pick-place-many`` episodes per (task, robot).
+"""Several-object tasks (issue 18) on several robots: bin-to-bin with five objects, shelf placing,
+clear-table and clear-table with mesh objects (a duck and a random_urdfs bar among a box and a
+cylinder, into the bin), ``run pick-place-many`` episodes per (task, robot).
 
     python benchmarks/bench_many.py [--episodes 50] [--seed 0] [--robots panda,ur5e_robotiq_2f85]
-                                    [--tasks pick_place_many,pick_place_shelf,clear_table]
+                                    [--tasks pick_place_many,pick_place_shelf,clear_table,clear_table_mesh]
                                     [--workers 1] [--json out.json]
 
 Per (task, robot): episodes with every object placed, objects placed, robot–fixture contacts
@@ -26,7 +27,7 @@ import tempfile
 import time
 from pathlib import Path
 
-TASKS = ("pick_place_many", "pick_place_shelf", "clear_table")
+TASKS = ("pick_place_many", "pick_place_shelf", "clear_table", "clear_table_mesh")
 ROBOTS = ("panda", "ur5e_robotiq_2f85")
 
 
