@@ -118,9 +118,12 @@ def test_a_path_that_cannot_be_levelled_is_given_back_unchanged(carry):
     assert np.array_equal(level_path(turned, checker, _fk(kin), _solve(kin), STEP, pivot), turned)
 
 
-def test_the_planned_pick_place_carries_the_cube_without_turning_the_hand():
-    """Seed 0, episode 0 of the obstacle task (its raw transport path tilted the hand 21°): the
-    transport path the planner drove keeps the hand within the limit, and the cube was placed."""
+@pytest.mark.parametrize("episode", [0, 6])
+def test_the_planned_pick_place_carries_the_cube_without_turning_the_hand(episode):
+    """Seed 0 of the obstacle task: episode 0's raw transport path tilted the hand 21°; in
+    episode 6 a levelled waypoint where the raw one was would take the cube through the wall's
+    edge (it is raised). The transport path the planner drove keeps the hand within the limit,
+    and the cube was placed."""
     from robocfg.engine import RunOptions
     from robocfg.runners.pick_place import PickPlaceRunner
 
@@ -128,7 +131,7 @@ def test_the_planned_pick_place_carries_the_cube_without_turning_the_hand():
     params = task.config.pick_place.model_copy(update={"motion": "planned"})
     task = replace(task, config=task.config.model_copy(update={"pick_place": params}))
     with PickPlaceRunner(task, RunOptions(seed=0, episodes=1)).open_session() as session:
-        record = session.run(0)
+        record = session.run(episode)
         drive = session.tools.planned
         kin = session.tools.model
     assert record.success, (record.failed_phase, record.reason)

@@ -13,8 +13,10 @@ samples.
 orientation of the path's goal, turned about the held object's centre (``pivot``), which stays
 where the path had it, clear of the scene; where a straight joint segment between two waypoints
 is not valid, or turns the hand by more than ``max_tilt`` from that orientation between them, it
-goes through a midpoint solved the same way (halving, ``max_depth`` times at most). If a waypoint
-has no collision-free IK answer or a segment cannot be mended so, the path is returned as it was:
+goes through a midpoint solved the same way (halving, ``max_depth`` times at most). A waypoint
+that cannot be reached so from the one before is tried raised by ``rises`` (over the edge the
+turn had cleared: on the obstacle task 4 of 30 carries needed it). If no height works for a
+waypoint, or the last segment cannot be mended, the path is returned as it was:
 the result is always collision-free for the checker at ``step``. Joint values in rad (arm order),
 angles in rad, poses world_T_ee (4×4, m).
 """
@@ -37,6 +39,7 @@ class LevelSettings:
     max_tilt: float = np.radians(6.0)  # rad: most the hand may turn from the goal's orientation between waypoints
     samples: int = 8  # points per segment at which the hand's turn is measured (ends excluded)
     max_depth: int = 3  # halvings of one segment at most (≤ 2³ − 1 inserted waypoints per segment)
+    rises: tuple[float, ...] = (0.0, 0.03, 0.06)  # m: heights a levelled waypoint is tried at, in turn
 
 
 def turn(R: np.ndarray, R_goal: np.ndarray) -> float:
@@ -57,13 +60,13 @@ def level_path(path: np.ndarray, checker: CollisionChecker, fk: Fk, solve: Solve
         return P
     pivot = np.zeros(3) if pivot is None else np.asarray(pivot, float)
 
-    def level(q: np.ndarray) -> np.ndarray | None:
+    def level(q: np.ndarray, rise: float = 0.0) -> np.ndarray | None:
         T = fk(q)
-        if turn(T[:3, :3], R_goal) <= 1e-9:
+        if rise == 0.0 and turn(T[:3, :3], R_goal) <= 1e-9:
             return q
         T_new = T.copy()
         T_new[:3, :3] = R_goal
-        T_new[:3, 3] = T[:3, :3] @ pivot + T[:3, 3] - R_goal @ pivot
+        T_new[:3, 3] = T[:3, :3] @ pivot + T[:3, 3] - R_goal @ pivot + [0.0, 0.0, rise]
         q_new = solve(T_new, q)
         return q_new if q_new is not None and checker.is_valid(q_new) else None
 
@@ -84,12 +87,15 @@ def level_path(path: np.ndarray, checker: CollisionChecker, fk: Fk, solve: Solve
         return [*first, *second]
 
     out = [P[0]]
-    for q in [*P[1:-1], None]:
-        target = P[-1] if q is None else level(q)
-        if target is None:
-            return P
-        part = connect(out[-1], target, 0)
+    for q in P[1:-1]:  # each waypoint levelled where it was, else raised (over what the turn avoided)
+        part = None
+        for rise in settings.rises:
+            target = level(q, rise)
+            part = None if target is None else connect(out[-1], target, 0)
+            if part is not None:
+                break
         if part is None:
             return P
         out += part
-    return np.asarray(out)
+    last = connect(out[-1], P[-1], 0)
+    return P if last is None else np.asarray([*out, *last])
