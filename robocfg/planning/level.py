@@ -3,8 +3,8 @@
 A joint path from RRT-Connect passes through random arm configurations, so the hand turns on the
 way (measured on the obstacle task: tilts up to 21° and turns up to 8° about the vertical going
 over the wall, and back). The held box lags a fraction of a degree behind the pads as the hand
-turns, and PyBullet's finger–box contact manifolds then gather up to 4 points a pad instead of
-one, which they keep until the release: physics steps cost about twice as much for the rest of
+turns, and PyBullet's finger–box contact manifolds then gather 3–7 points between the two pads
+instead of 2, which they keep until the release: physics steps cost about twice as much for the rest of
 the carry and the lowering (transport 209 against 133 µs a step, lower 246 against 103, against
 the trajectory mode without the wall, 10 episodes). Nothing made the hand turn but the random
 samples.
