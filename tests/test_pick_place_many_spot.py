@@ -85,3 +85,32 @@ def test_the_hand_turns_to_clear_a_wall_and_a_spot_where_no_turn_fits_is_refused
             walls.choose(mover, T1, xy1, [xy1], 0.12, q0)
         assert exc.value.phase == "transport"
         assert "no place spot in 'bin' keeps the open hand 10 mm clear of its walls" in exc.value.reason
+
+
+def test_a_turn_that_would_put_the_hand_on_a_placed_object_is_not_taken(duck_task):
+    """The objects where they lie are in the check too (the clutter margin): with the red box
+    placed where the turned hand's finger would come down (the turn the walls alone allow), that
+    turn is not taken: another one that clears both is, or the spot is refused naming the objects."""
+    import math
+
+    with open_session(duck_task, RunOptions(seed=0)) as session:
+        walls, world = session.walls, session.world
+        mover = ArmMover(world, session.handle, session.tools.model, session.tools.limits, phase="transport")
+        q0 = np.asarray(session.arm_cfg.home, float)
+        T, xy = _near_wall(session, 0.06)
+        first = walls.choose(mover, T, xy, [xy], 0.12, q0)  # no object spawned yet: the walls alone
+        a = math.radians(first.turn_deg)
+        closing = np.array([math.cos(a), math.sin(a)])  # the fingers close along world x before the turn
+        red = next(b for b in session.bodies if b.name == "red")
+        world.add_body(red)
+        at = xy - 0.075 * closing  # a 5 cm box whose near face is 5 cm from the spot, away from the wall
+        world.set_body_pose("red", np.array([*at, float(session.spots[0].z) + 0.025]))
+        walls.see_objects(world, held="duck")
+        hit = walls.hits(mover, first.T_place, 0.12, q0)
+        assert hit is not None and "red" in hit, hit
+        try:
+            other = walls.choose(mover, T, xy, [xy], 0.12, q0)
+        except PhaseFailed as exc:
+            assert "mm clear of the objects" in exc.reason
+        else:
+            assert other.turn_deg != first.turn_deg and walls.hits(mover, other.T_place, 0.12, q0) is None

@@ -136,7 +136,8 @@ class ManySession(EpisodeSession[ManyEpisode]):
         scene = self.task.config.scene
         if not isinstance(place_fixture(scene, self.params.place), BinFixture):
             return None
-        return BinWalls.build(self.task.robots[0], model, scene, self.params.place.fixture)
+        return BinWalls.build(self.task.robots[0], model, scene, self.params.place.fixture, self.bodies,
+                              self.task.path.parent, self.params.clutter_margin)
 
     def _machines(self, k: int, recorder: FrameRecorder | None,
                   on_step: Callable[[], None] | None) -> dict[str, ObjectMachine]:

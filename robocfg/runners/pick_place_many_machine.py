@@ -10,7 +10,7 @@ for an object already lying in a scene full of others, with two changes:
   left out). Among the kept ones the choice is pick-place's (least joint travel);
 * **the place spot**: a bin spot is approached from ``lift_height`` above and left straight up,
   the hand turned about the object's vertical (or the object sent to a spare spot) so that the
-  open hand clears the bin's walls (:mod:`.pick_place_many_spot`); a
+  open hand clears the bin's walls and the objects already placed (:mod:`.pick_place_many_spot`); a
   shelf spot is entered ``place_clearance`` above its board (the planner finds the way in through
   the open front), lowered onto (the hand goes on down until the board carries the object:
   ``SET_DOWN_PRESS``), and left by lifting back to that height and withdrawing out of the front
@@ -268,6 +268,7 @@ class ObjectMachine(_StateMachine):
         the least about the object's vertical so the open hand clears the bin's walls up to
         ``top`` m above it (:mod:`.pick_place_many_spot`); the spot taken becomes ``place_xy``."""
         spots = [self.setup.place_xy, *self.spare_xy]
+        walls.see_objects(self.world, held=self.setup.body.name)
         choice = walls.choose(self.mover, T_place, self.setup.place_xy, spots, top, self.arm.joint_positions())
         if choice.turn_deg or not np.allclose(choice.xy, self.setup.place_xy):
             self.log(f"  place: spot [{choice.xy[0]:.3f}, {choice.xy[1]:.3f}] m, hand turned {choice.turn_deg:+.0f}° "

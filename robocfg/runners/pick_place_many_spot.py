@@ -6,10 +6,11 @@ axis, the open fingers 0.1 m) and, for an object grasped low, comes down below t
 duck placed 9 cm from a wall pressed the Panda's hand into it while lowering. So before the
 transport the hand's turn about the vertical through the object's centre (the object turns with
 it) is chosen such that the arm and the gripper, fingers open (the release width: the kinematic
-model holds the gripper open), keep ``WALL_MARGIN`` from the bin's walls at the place pose and all
-along the straight line up to the highest pose the lower starts from or the retract ends at —
-tested with pinocchio + coal on the robot's own collision geometry
-(:class:`~robocfg.planning.checker.CollisionChecker` holding the walls only). The turn nearest
+model holds the gripper open), keep ``WALL_MARGIN`` from the bin's walls, and the clutter margin
+from the objects where they lie (those already placed), at the place pose and all along the
+straight line up to the highest pose the lower starts from or the retract ends at — tested with
+pinocchio + coal on the robot's own collision geometry (two
+:class:`~robocfg.planning.checker.CollisionChecker`: the walls; the objects, the held one parked). The turn nearest
 zero is taken (turning by 0 changes nothing); a spot where no turn fits gives way to the next free
 spot; when none fits anywhere the phase fails naming what the hand would touch.
 
@@ -19,7 +20,9 @@ Frames: world, 4×4, metres; turns in degrees about the world's z axis.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,10 +31,11 @@ from robocfg.motion.moves import MoveFailed
 
 if TYPE_CHECKING:
     from robocfg.checks.robot import CheckedRobot
-    from robocfg.config.scene import Scene
+    from robocfg.config.scene import Body, Scene
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.moves import ArmMover
     from robocfg.planning.checker import CollisionChecker
+    from robocfg.sim.world import World
 
 WALL_MARGIN = 0.01  # m the open hand and the arm keep from a bin's walls (the planner's margin)
 # turns (deg) tried, nearest first; a parallel gripper turned by 180° is the same hand
@@ -60,23 +64,41 @@ class PlaceChoice:
 
 
 class BinWalls:
-    """The walls of the bin the objects go into, as a collision model of the arm with the gripper
-    open among them (see the module doc)."""
+    """The walls of the bin the objects go into, and the objects, as collision models of the arm
+    with the gripper open among them (see the module doc)."""
 
-    def __init__(self, checker: CollisionChecker, fixture: str):
-        self.checker, self.fixture = checker, fixture
+    def __init__(self, checker: CollisionChecker, fixture: str, objects: CollisionChecker | None = None):
+        self.checker, self.fixture, self.objects = checker, fixture, objects
 
     @classmethod
-    def build(cls, robot: CheckedRobot, kin: KinematicModel, scene: Scene, fixture: str) -> BinWalls:
-        """Walls (every part but the floor) of bin ``fixture`` of ``scene`` around the arm of ``kin``."""
+    def build(cls, robot: CheckedRobot, kin: KinematicModel, scene: Scene, fixture: str,
+              objects: Sequence[Body] = (), base_dir: Path = Path("."), object_margin: float = 0.0) -> BinWalls:
+        """Walls (every part but the floor) of bin ``fixture`` of ``scene`` around the arm of
+        ``kin``; ``objects`` (parked until :meth:`see_objects` puts them where they lie) kept
+        ``object_margin`` (m) from; ``base_dir`` resolves their mesh paths."""
         from robocfg.collision import robot_geometry
+        from robocfg.collision.bodies import body_env_shape
         from robocfg.motion.reactive.setup import scene_shapes
         from robocfg.planning.checker import CollisionChecker
+        from robocfg.planning.drive import PARKED
 
         links, _ = robot_geometry(robot)
         env, _ = scene_shapes(scene)
         walls = [e for e in env if e.name.startswith(f"{fixture}/") and e.name != f"{fixture}/floor"]
-        return cls(CollisionChecker(kin, links, walls, WALL_MARGIN), fixture)
+        shapes = [body_env_shape(b, PARKED, base_dir) for b in objects]
+        neighbours = CollisionChecker(kin, links, shapes, object_margin) if shapes else None
+        return cls(CollisionChecker(kin, links, walls, WALL_MARGIN), fixture, neighbours)
+
+    def see_objects(self, world: World, held: str) -> None:
+        """Put the objects where they lie in ``world``; ``held`` (and any not spawned) parked."""
+        from robocfg.geometry import pose_to_matrix
+        from robocfg.planning.drive import PARKED
+
+        if self.objects is None:
+            return
+        for name in self.objects.env:
+            T = pose_to_matrix(*world.body_pose(name)) if name != held and name in world.bodies else PARKED
+            self.objects.move_shape(name, T)
 
     def hits(self, mover: ArmMover, T_place: np.ndarray, top: float, q0: np.ndarray) -> str | None:
         """What the arm touches (within the margin) at ``T_place`` or on the straight line up to
@@ -90,9 +112,10 @@ class BinWalls:
         except MoveFailed as exc:
             return exc.reason
         for qi in line:
-            if not self.checker.is_valid(qi):
-                hit = self.checker.contacts(qi)
-                return hit[0].describe() if hit else "a wall within the margin"
+            for checker in (self.checker, self.objects):
+                if checker is not None and not checker.is_valid(qi):
+                    hit = checker.contacts(qi)
+                    return hit[0].describe() if hit else "a pair within the margin"
         return None
 
     def choose(self, mover: ArmMover, T_place: np.ndarray, obj_xy: np.ndarray, spots: list[np.ndarray],
@@ -111,6 +134,7 @@ class BinWalls:
                     return PlaceChoice(np.asarray(xy, float), deg, T)
                 if deg == 0.0:
                     misses.append(f"[{xy[0]:.3f}, {xy[1]:.3f}]: {why}")
+        objects = "" if self.objects is None else f" and {self.objects.margin * 1000:.0f} mm clear of the objects"
         raise MoveFailed(mover.phase, f"no place spot in {self.fixture!r} keeps the open hand "
-                                      f"{WALL_MARGIN * 1000:.0f} mm clear of its walls at any turn "
+                                      f"{WALL_MARGIN * 1000:.0f} mm clear of its walls{objects} at any turn "
                                       f"(unturned: {'; '.join(misses)})")
