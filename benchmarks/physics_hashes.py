@@ -86,13 +86,15 @@ def _strip(obj):
     return obj
 
 
-def _files_hash(folder: Path) -> str | None:
+def _files_hash(folder: Path, tmp: str) -> str | None:
+    """SHA-1 of the files under ``folder`` (names and bytes; the checkout's and the temp folder's
+    paths masked: compare checkouts at paths of the same length, as binary files may hold them)."""
     if not folder.exists():
         return None
     sha = hashlib.sha1()
     for f in sorted(q for q in folder.rglob("*") if q.is_file()):
         sha.update(str(f.relative_to(folder)).encode())
-        sha.update(f.read_bytes())
+        sha.update(f.read_bytes().replace(str(ROOT).encode(), b"<root>").replace(tmp.encode(), b"<tmp>"))
     return sha.hexdigest()
 
 
@@ -106,11 +108,11 @@ def run_one(name: str, args: list[str]) -> dict:
             raise SystemExit(f"{name}: no hash (exit {proc.returncode}):\n{proc.stderr[-2000:]}")
         out = json.loads(line.split(" ", 1)[1]) | {"exit": proc.returncode}
         report = Path(tmp, "r.json")
-        if report.exists():
-            out["report_sha1"] = hashlib.sha1(json.dumps(_strip(json.loads(report.read_text())),
-                                                         sort_keys=True).encode()).hexdigest()
+        if report.exists():  # where the checkout and the temp folder are is not part of the result
+            text = report.read_text().replace(str(ROOT), "<root>").replace(tmp, "<tmp>")
+            out["report_sha1"] = hashlib.sha1(json.dumps(_strip(json.loads(text)), sort_keys=True).encode()).hexdigest()
         for ds in sorted(Path(tmp).glob("ds_*")):
-            out[f"{ds.name}_sha1"] = _files_hash(ds)
+            out[f"{ds.name}_sha1"] = _files_hash(ds, tmp)
         return out
 
 

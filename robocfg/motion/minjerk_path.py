@@ -42,15 +42,16 @@ class MinJerkPath(Trajectory):
     straight segment, no spline built)."""
 
     def __init__(self, waypoints: np.ndarray, limits: JointLimits, min_duration: float = 0.05):
-        W = np.asarray(waypoints, dtype=float)
+        W = np.array(waypoints, dtype=float)  # a copy: the path keeps its own waypoints
         seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
-        keep = np.concatenate([[True], seg > 1e-9])
-        W = W[keep]
-        if len(W) < 2:
-            W = np.vstack([W, W])
-            seg = np.array([1.0])
-        else:
-            seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
+        moved = seg > 1e-9
+        if len(W) < 2 or not moved.all():  # repeated waypoints dropped (else W and seg stay as they are)
+            W = W[np.concatenate([[True], moved])]
+            if len(W) < 2:
+                W = np.vstack([W, W])
+                seg = np.array([1.0])
+            else:
+                seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
         self.waypoints = W
         self.spline: _Segment | CubicSpline
         if len(W) == 2:  # a straight segment: linear in s

@@ -90,19 +90,27 @@ class ArmMover:
     def solve(self, T: np.ndarray, seed: np.ndarray, what: str = "") -> np.ndarray:
         res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
         if not res.converged:
-            raise MoveFailed(self.phase, f"unreachable{what} (residual {res.pos_err * 1000:.1f} mm, "
-                                         f"{math.degrees(res.rot_err):.1f}°)")
+            raise self._unreachable(res, what)
         return res.q
+
+    def _unreachable(self, res, what: str) -> MoveFailed:
+        return MoveFailed(self.phase, f"unreachable{what} (residual {res.pos_err * 1000:.1f} mm, "
+                                      f"{math.degrees(res.rot_err):.1f}°)")
 
     def straight_waypoints(self, q0: np.ndarray, T_goal: np.ndarray) -> np.ndarray:
         """Joint waypoints along the straight EE line from FK(q0) to ``T_goal`` (orientation of the goal)."""
         T0 = self.model.fk(q0, "ee")
-        n = max(2, math.ceil(np.linalg.norm(T_goal[:3, 3] - T0[:3, 3]) / CARTESIAN_STEP) + 1)
+        p0, p1 = T0[:3, 3], T_goal[:3, 3]
+        n = max(2, math.ceil(np.linalg.norm(p1 - p0) / CARTESIAN_STEP) + 1)
         waypoints, q = [q0], q0
+        ik, budget = self.model.ik, self.ik_budget
         for s in np.linspace(0, 1, n)[1:]:
             T = T_goal.copy()
-            T[:3, 3] = (1 - s) * T0[:3, 3] + s * T_goal[:3, 3]
-            q_next = self.solve(T, q, f" at {s:.0%} of the straight line")
+            T[:3, 3] = (1 - s) * p0 + s * p1
+            res = ik(T, seed_q=q, frame="ee", time_budget=budget)  # self.solve, its message made on failure only
+            if not res.converged:
+                raise self._unreachable(res, f" at {s:.0%} of the straight line")
+            q_next = res.q
             jump = float(np.max(np.abs(q_next - q)))
             if jump > MAX_JOINT_JUMP:
                 raise MoveFailed(self.phase, f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at {s:.0%})")

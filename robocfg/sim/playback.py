@@ -48,11 +48,14 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
     q, qd = np.asarray(q, dtype=float), np.asarray(qd, dtype=float)
     if q.ndim != 2 or q.shape[1] != len(key) or qd.shape != q.shape:
         raise ValueError(f"targets of shape {q.shape} and velocities of shape {qd.shape} for {len(key)} arm joints")
-    q_rows, qd_rows = q.tolist(), qd.tolist()  # once, not per step
     intercepted = "command" in vars(arm)
+    plan = None if intercepted else robot.motor_plan(key)
+    if plan is not None and after is None and world.idle():
+        _play_bare(world, arm, plan, q, qd)  # converts its rows chunk by chunk
+        return
+    q_rows, qd_rows = q.tolist(), qd.tolist()  # once, not per step
     if intercepted and world.play_through is not None and world.play_through(arm, q_rows, qd_rows, after):
         return
-    plan = None if intercepted else robot.motor_plan(key)
     if plan is None:
         for row, speeds in zip(q_rows, qd_rows):  # noqa: B905 - shapes checked above
             arm.command(row, speeds)
@@ -60,33 +63,37 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
             if after is not None:
                 after()
         return
-    if after is None and world.idle():
-        _play_bare(world, arm, plan, q_rows, qd_rows)
-    else:
-        _play_hooked(world, arm, plan, q_rows, qd_rows, after)
+    _play_hooked(world, arm, plan, q_rows, qd_rows, after)
 
 
-def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd_rows: list) -> None:
-    """The bare loop (module docstring): one motor call and one physics step per row."""
+def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q: np.ndarray, qd: np.ndarray) -> None:
+    """The bare loop (module docstring): one motor call and one physics step per row. The rows
+    become Python lists one check period at a time (what PyBullet reads fastest), so a move's
+    targets never exist as one big list of floats: the chunk's floats are freed before the next
+    chunk's are made (and come back from Python's free list, in cache)."""
     _, idx, kp, kd, force, drives = plan
     robot = arm.robot
     body, client, mode = robot.body_id, robot.client, p.POSITION_CONTROL
     send, stepsim, clock = p.setJointMotorControlArray, p.stepSimulation, time.perf_counter
-    every, steps, n = world.check_every, world.steps, len(q_rows)
+    every, steps, n = world.check_every, world.steps, len(q)
     physics, i, j = 0.0, 0, -1
+    rows: list = []
+    speeds: list = []
     try:
         while i < n:
             end = min(n, i + every - steps % every)  # the next check is after this chunk's last step
+            rows, speeds = q[i:end].tolist(), qd[i:end].tolist()
+            j = -1
             try:
-                for j in range(i, end):
+                for j, row in enumerate(rows):  # j is read when a step raises
                     # positional: setJointMotorControlArray(body, joints, mode, targetPositions,
                     # targetVelocities, forces, positionGains, velocityGains, physicsClientId)
-                    send(body, idx, mode, q_rows[j], qd_rows[j], force, kp, kd, client)
+                    send(body, idx, mode, row, speeds[j], force, kp, kd, client)
                     t0 = clock()
-                    stepsim(physicsClientId=client)
+                    stepsim(client)
                     physics += clock() - t0
-            except BaseException:  # stopped inside the chunk: steps i..j-1 were taken
-                world.steps = steps + j - i
+            except BaseException:  # stopped inside the chunk: its steps before j were taken
+                world.steps = steps + max(j, 0)
                 world.t = world.steps * world.dt
                 raise
             steps += end - i
@@ -97,7 +104,9 @@ def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd_r
     finally:
         world.physics_seconds += physics
         if j >= 0:  # the drives remember the last targets sent, as command() leaves them
-            _remember(drives, q_rows[j], qd_rows[j])
+            _remember(drives, rows[j], speeds[j])
+        elif i > 0:  # stopped between two chunks
+            _remember(drives, q[i - 1].tolist(), qd[i - 1].tolist())
 
 
 def _play_hooked(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd_rows: list,
@@ -127,7 +136,7 @@ def _play_hooked(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd
                 send(body, idx, mode, row, speeds, force, kp, kd, client)
                 sent = (row, speeds)
             t0 = clock()
-            stepsim(physicsClientId=client)
+            stepsim(client)
             physics += clock() - t0
             world.steps = steps = world.steps + 1
             world.t = steps * dt
@@ -157,7 +166,7 @@ def advance_idle(world: World, n: int) -> None:
             try:
                 for k in range(m):  # noqa: B007 - k is read when a step raises
                     t0 = clock()
-                    stepsim(physicsClientId=client)
+                    stepsim(client)
                     physics += clock() - t0
             except BaseException:  # stopped inside the chunk: its steps before k were taken
                 world.steps = steps + k
@@ -207,7 +216,7 @@ def play_latched(world: World, arm: ArmHandle, q_rows: list, gate: Latched, step
         for row in q_rows:
             gate.q_wanted = row
             t0 = clock()
-            stepsim(physicsClientId=client)
+            stepsim(client)
             physics += clock() - t0
             world.steps = steps = world.steps + 1
             world.t = steps * dt

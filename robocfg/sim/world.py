@@ -337,20 +337,29 @@ class World(SceneQueries):
         self._check()
 
     def _check(self) -> None:
+        # positional client ids (no keyword dict per call): this runs every check period
         c, vmax, vbody = self.client, self.max_joint_velocity, self.max_body_speed
+        states, base_velocity = p.getJointStates, p.getBaseVelocity
         for r in self.robots:
             idx = r._movable_indices
             if not idx:
                 continue
-            for k, s in enumerate(p.getJointStates(r.body_id, idx, physicsClientId=c)):
+            joints = states(r.body_id, idx, c)
+            for s in joints:
                 if not -vmax <= s[1] <= vmax:  # also catches NaN
-                    raise PhysicsDiverged(self.t, f"robot {r.name!r} joint {r.movable_joints[k]!r} velocity {s[1]:.3g}")
+                    self._diverged_joint(r, [js[1] for js in joints])
         for bid in self._dynamic:
-            lin = p.getBaseVelocity(bid, physicsClientId=c)[0]
+            lin = base_velocity(bid, c)[0]
             speed = math.sqrt(lin[0] ** 2 + lin[1] ** 2 + lin[2] ** 2)
             if not speed <= vbody:
                 name = next((k for k, v in self.bodies.items() if v == bid), str(bid))
                 raise PhysicsDiverged(self.t, f"body {name!r} speed {speed:.3g} m/s")
+
+    def _diverged_joint(self, robot: RobotHandle, velocities: list[float]) -> None:
+        """Raise PhysicsDiverged naming ``robot``'s first joint whose velocity is out of bounds."""
+        vmax = self.max_joint_velocity
+        k = next(k for k, v in enumerate(velocities) if not -vmax <= v <= vmax)
+        raise PhysicsDiverged(self.t, f"robot {robot.name!r} joint {robot.movable_joints[k]!r} velocity {velocities[k]:.3g}")
 
     # ---- convenience ----------------------------------------------------------------------
     @property
