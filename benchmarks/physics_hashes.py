@@ -75,12 +75,13 @@ from robocfg.cli.app import main
 main()
 """
 
-_TIMING_KEYS = {"wall_s", "timing", "elapsed_s", "physics_s", "episodes_per_s", "wall", "cpu_s"}
+_TIMING_KEYS = {"wall_s", "timing", "elapsed_s", "physics_s", "episodes_per_s", "wall", "cpu_s"}  # and any key with "time" or "cpu"
 
 
 def _strip(obj):
     if isinstance(obj, dict):
-        return {k: _strip(v) for k, v in obj.items() if k not in _TIMING_KEYS and "time" not in k.lower()}
+        return {k: _strip(v) for k, v in obj.items()
+                if k not in _TIMING_KEYS and "time" not in k.lower() and "cpu" not in k.lower()}
     if isinstance(obj, list):
         return [_strip(v) for v in obj]
     return obj
