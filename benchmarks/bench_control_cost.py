@@ -14,10 +14,14 @@ order that rotates with k, so machine load falls on all alike:
   state-only dataset of each of ``--formats`` (default: lerobot; ``--formats ""``: none).
 
 The headline, robocfg's own work ÷ physics (the issue's "own work ÷ physics time"), is the median
-over k of (untimed CPU − physics CPU) ÷ physics CPU: no timer's cost is in it. The same ratio
-from the physics and the buckets runs (their timers' CPU, calibrated on a no-op before the
-episodes, removed) is printed as a cross-check: it comes out higher, because a timer costs more in
-situ (after a physics step, with cold caches) than in the calibration loop.
+over k of (CPU − timers − physics) ÷ physics in the physics-only run: one timer a physics step,
+its cost calibrated on a no-op before the episodes and removed. A timer costs more in situ (after
+a physics step, with cold caches) than in the calibration loop, so this reads a little high. Two
+cross-checks without any timer in them: the untimed run split by the world's own wall clock
+(``World.physics_seconds``, ``perf_counter`` around each step: preemption falls on both sides),
+and the untimed run's CPU minus the physics-only run's physics (a difference of two runs: on a
+loaded machine the same steps' CPU differs by 10–20 % between runs, so this one swings); the
+bucketed run's own figure, higher still (its many timers' in-situ excess), is printed too.
 
 The buckets are **exclusive**: a bucket's time excludes the wrapped calls inside it (IK inside the
 grasp choice counts as IK), and what no bucket holds is "other". Besides the main costs (motor
@@ -305,9 +309,12 @@ def main() -> None:
         return (c - b["_timers"] - b["stepSimulation"]) / b["stepSimulation"]
 
     phys = [b["stepSimulation"] for _, b in physics_runs]
-    # The headline: the CPU of the untimed run of episode k minus the physics of its physics-only run.
-    own = med([(u - ph) / ph for u, ph in zip(untimed, phys, strict=True)])
-    physics, cpu = med(phys), med(untimed)
+    # The headline: the physics-only run, one timer a physics step, its calibrated cost removed.
+    own = med([own_of(r) for r in physics_runs])
+    # The untimed run's CPU minus the physics of the physics-only run of the same episode: no timer
+    # in it, but a difference of two runs (under load their CPU per step can differ by 10-20 %).
+    own_paired = med([(u - ph) / ph for u, ph in zip(untimed, phys, strict=True)])
+    physics, cpu = med(phys), med([c - b["_timers"] for c, b in physics_runs])
     labels = list(dict.fromkeys(label for *_, label in BUCKETS))
     buckets = {label: med([b.get(label, 0.0) for _, b in none]) for label in labels}
     calls = {label: med([b.get(f"calls:{label}", 0.0) for _, b in none]) for label in labels}
@@ -320,7 +327,8 @@ def main() -> None:
     cost = {f: med([net(d) / net(n) for n, d in zip(none, runs[f], strict=True)]) for f in formats}
     res = {"task": args.task, "episodes": args.episodes, "cpu_per_episode_ms": round(cpu * 1e3, 2),
            "physics_per_episode_ms": round(physics * 1e3, 2), "own_share_of_physics": round(own, 3),
-           "own_share_physics_run": round(med([own_of(r) for r in physics_runs]), 3),
+           "own_share_untimed_minus_physics": round(own_paired, 3),
+           "cpu_per_episode_untimed_ms": round(med(untimed) * 1e3, 2),
            "own_share_wall_untimed": round(med([(w - ph) / ph for w, ph in walls]), 3),
            "own_share_bucket_run": round(med([own_of(r) for r in none]), 3),
            "physics_bucket_run_ms": round(phys_buckets * 1e3, 2),
@@ -334,12 +342,14 @@ def main() -> None:
            "dataset_cpu_per_episode_ms": {f: round(med([net(r) for r in runs[f]]) * 1e3, 2) for f in formats},
            "fixed_ms": {f: round(v * 1e3, 1) for f, v in fixed.items()}}
     print(f"{args.task}: {cpu * 1e3:.1f} ms CPU per episode, {physics * 1e3:.1f} ms in stepSimulation; robocfg's own "
-          f"work {own:.1%} of physics (median over episodes 1..{args.episodes} of (untimed CPU − physics) ÷ physics)")
-    print(f"  cross-checks: {res['own_share_physics_run']:.1%} from the physics-only timed run, "
+          f"work {own:.1%} of physics (median over episodes 1..{args.episodes}, the physics-only run: one timer a "
+          f"step, {res['timer_overhead_ms']['physics_run']:.1f} ms an episode by calibration removed; what a timer costs "
+          f"beyond that in situ stays in, so this reads a little high)")
+    print(f"  cross-checks: {res['own_share_wall_untimed']:.1%} by the world's own wall clock in the untimed run "
+          f"(episode − time inside stepSimulation, ÷ the latter; no timer, preemption falls in both); "
+          f"{own_paired:.1%} as untimed CPU − the physics-only run's physics (no timer, but two runs: noisy under load); "
           f"{res['own_share_bucket_run']:.1%} from the bucketed run (its timers, {res['timer_overhead_ms']['bucket_run']:.1f} ms "
-          f"an episode at {meter.cost_in * 1e6:.2f} + {meter.cost_out * 1e6:.2f} µs a call by calibration, removed; what they "
-          f"cost beyond that in situ stays in its buckets); {res['own_share_wall_untimed']:.1%} by the world's wall "
-          f"clock in the untimed run (episode − time inside stepSimulation, ÷ the latter; preemption falls in both)")
+          f"an episode at {meter.cost_in * 1e6:.2f} + {meter.cost_out * 1e6:.2f} µs a call by calibration, removed)")
     print(f"  buckets of the bucketed run (exclusive; physics there {phys_buckets * 1e3:.1f} ms):")
     for label, v in sorted(buckets.items(), key=lambda kv: -kv[1]):
         print(f"  {label:26s} {v * 1e3:7.2f} ms  {v / phys_buckets:6.1%} of physics  ({calls[label]:.0f} calls)")
