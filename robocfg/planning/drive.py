@@ -181,27 +181,17 @@ def build_planned_drive(robot: CheckedRobot, world: World, kin: KinematicModel,
     starts, except while held; pick_place's object being picked is not among them."""
     from robocfg.collision import robot_geometry
     from robocfg.collision.bodies import body_env_shape
-    from robocfg.geometry import pose_matrix, pose_to_matrix
-    from robocfg.motion.reactive.setup import scene_shapes
+    from robocfg.motion.reactive.setup import MeshPoses, scene_shapes
     from robocfg.planning.checker import DEFAULT_MARGIN
 
     links, _ = robot_geometry(robot)
     scene = world.task.config.scene
-    base_dir = world.task.path.parent
-    env, unseen = scene_shapes(scene)
-
-    def where(body: Body) -> np.ndarray:  # a mesh's hull is in the body frame PyBullet reports
-        if body.name in world.bodies:
-            return pose_to_matrix(*world.body_pose(body.name))
-        return pose_matrix(body)
-
-    meshes = {b.name: b for b in scene.obstacles if b.shape == "mesh"}
-    env += [body_env_shape(meshes[name], where(meshes[name]), base_dir) for name in unseen if name in meshes]
-    skipped = [name for name in unseen if name not in meshes]
+    meshes = MeshPoses.of(world)  # mesh bodies' hulls where the world has them, as the controller sees them
+    env, skipped = scene_shapes(scene, meshes)
     loose = []
     for obj in [*scene.objects, *objects]:  # neighbours in clutter: kept clear of like obstacles
-        env.append(body_env_shape(obj, where(obj), base_dir))
+        env.append(body_env_shape(obj, meshes.pose(obj), meshes.base_dir))
         loose.append(obj.name)
     checker = CollisionChecker(kin, links, env, DEFAULT_MARGIN if margin is None else margin)
     return PlannedDrive(JointPlanner(checker, kin.lower, kin.upper, settings), kin, kin.ee_link, skipped,
-                        base_dir, loose)
+                        meshes.base_dir, loose)
