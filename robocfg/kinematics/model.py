@@ -93,6 +93,9 @@ class KinematicModel:
         # fixed after construction (``wrap``/``continuous`` are not changed in place): asked per IK query
         self._any_wrap = bool(self.wrap.any())
         self._any_continuous = self.continuous is not None and bool(self.continuous.any())
+        # the limits and the wrap flags as Python lists, for the per-query checks of seeds and answers
+        self._limit_lists = (self.lower.tolist(), self.upper.tolist())
+        self._wrap_list = self.wrap.tolist()
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -187,6 +190,16 @@ class KinematicModel:
     def any_wrap(self) -> bool:
         """True if some joint is continuous or ≥ 2π wide (wrapped instead of clamped)."""
         return self._any_wrap
+
+    @property
+    def limit_lists(self) -> tuple[list[float], list[float]]:
+        """(lower, upper) limits as Python lists (read only; ``lower``/``upper`` are not changed in place)."""
+        return self._limit_lists
+
+    @property
+    def wrap_list(self) -> list[bool]:
+        """``wrap`` as a Python list (read only)."""
+        return self._wrap_list
 
     @property
     def mid(self) -> np.ndarray:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -26,6 +26,7 @@ from robocfg.errors import PhaseFailed
 from robocfg.geometry import rotation_angle
 
 if TYPE_CHECKING:
+    from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import JointLimits
     from robocfg.motion.trajectory import Trajectory
@@ -86,9 +87,22 @@ class ArmMover:
     phase: str = "move"
     ik_budget: float = 1.0  # s of wall clock per IK query, for a model without bound_ik_by_iterations
     max_acceleration: float | None = None  # m/s²: the EE's peak acceleration in a timed move (a held load), None: free
+    _answers: dict[tuple[bytes, bytes], IKResult] = field(default_factory=dict, repr=False)  # see ik()
+
+    def ik(self, T: np.ndarray, seed: np.ndarray) -> IKResult:
+        """IK of the EE pose ``T`` (4x4, world) from ``seed`` (rad or m), remembered for the mover's
+        life (one episode) under the exact bytes of both: the grasp choice and the moves after it
+        ask some of the same questions (the pre-grasp pose from the same joints), and the solver's
+        answer depends on nothing else (an iteration budget, a fixed restart seed)."""
+        T, seed = np.asarray(T, dtype=float), np.asarray(seed, dtype=float)
+        key = (T.tobytes(), seed.tobytes())
+        res = self._answers.get(key)
+        if res is None:
+            res = self._answers[key] = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
+        return replace(res, q=res.q.copy())  # callers may keep or change their copy
 
     def solve(self, T: np.ndarray, seed: np.ndarray, what: str = "") -> np.ndarray:
-        res = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
+        res = self.ik(T, seed)
         if not res.converged:
             raise self._unreachable(res, what)
         return res.q
@@ -103,11 +117,11 @@ class ArmMover:
         p0, p1 = T0[:3, 3], T_goal[:3, 3]
         n = max(2, math.ceil(np.linalg.norm(p1 - p0) / CARTESIAN_STEP) + 1)
         waypoints, q = [q0], q0
-        ik, budget = self.model.ik, self.ik_budget
+        ik = self.ik
         for s in np.linspace(0, 1, n)[1:]:
             T = T_goal.copy()
             T[:3, 3] = (1 - s) * p0 + s * p1
-            res = ik(T, seed_q=q, frame="ee", time_budget=budget)  # self.solve, its message made on failure only
+            res = ik(T, q)  # self.solve, its message made on failure only
             if not res.converged:
                 raise self._unreachable(res, f" at {s:.0%} of the straight line")
             q_next = res.q
@@ -225,7 +239,7 @@ class ArmMover:
         if self.timeout is not None:
             return None
         q0 = self.arm.joint_positions()
-        res = self.model.ik(T_goal, seed_q=q0, frame="ee", time_budget=self.ik_budget)
+        res = self.ik(T_goal, q0)
         if not res.converged or np.max(np.abs(res.q - q0)) < 1e-6:
             return None
         return float(MinJerkPath(np.asarray([q0, res.q]), self.limits).duration)

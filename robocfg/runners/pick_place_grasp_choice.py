@@ -66,7 +66,7 @@ class GraspChoice:
             T_grasp = ee_pose_from_grasp(g, self.cfg)
             cost, q, lines = 0.0, q0, []
             for T, T_down in ((T_pre, T_grasp), (shifted(T_pre, shift), shifted(T_grasp, shift))):
-                res = self.model.ik(T, seed_q=q, frame="ee", time_budget=self.mover.ik_budget)
+                res = self.mover.ik(T, q)
                 if not res.converged:
                     return math.inf, []
                 cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q

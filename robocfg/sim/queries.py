@@ -56,27 +56,34 @@ class SceneQueries:
         length = float(np.linalg.norm(b - a))
         if length == 0.0:
             return []
-        d = (b - a) / length
+        # Python floats from here (the same IEEE operations as the arrays' element by element,
+        # without numpy's per-call cost on 3-vectors): the direction, and the ray's start per cast
+        dx, dy, dz = d = ((b - a) / length).tolist()
+        ax, ay, az = a.tolist()
+        to = b.tolist()
+        axes = [k for k in range(3) if abs(d[k]) > 1e-12]
+        ray, aabb, c = p.rayTest, p.getAABB, self.client
         hits: list[RayHit] = []
         seen: set[tuple[int, int]] = set()
-        s, step, last = a, 1e-4, (-1, -1)
+        s, step, last = [ax, ay, az], 1e-4, (-1, -1)
         for _ in range(8 * max_hits):
-            h = p.rayTest(list(s), list(b), physicsClientId=self.client)[0]
+            h = ray(s, to, physicsClientId=c)[0]
             if h[0] < 0:
                 break
-            key = (int(h[0]), int(h[1]))
+            key = (h[0], h[1])
             step = 2.0 * step if key == last else 1e-4
             last = key
+            hx, hy, hz = hit = h[3]
             if key not in seen:
                 seen.add(key)
-                hits.append(RayHit(key[0], tuple(h[3])))
+                hits.append(RayHit(key[0], (hx, hy, hz)))
                 if len(hits) >= max_hits:
                     break
-            hit = np.asarray(h[3], dtype=float)
-            lo, hi = p.getAABB(h[0], h[1], physicsClientId=self.client)
-            exits = [((hi[k] if d[k] > 0 else lo[k]) - hit[k]) / d[k] for k in range(3) if abs(d[k]) > 1e-12]
-            s = hit + min(step, max(min(exits), 0.0) + 1e-4) * d
-            if float(np.dot(s - a, d)) >= length:
+            lo, hi = aabb(h[0], h[1], physicsClientId=c)
+            exits = [((hi[k] if d[k] > 0 else lo[k]) - hit[k]) / d[k] for k in axes]
+            m = min(step, max(min(exits), 0.0) + 1e-4)
+            s = [hx + m * dx, hy + m * dy, hz + m * dz]
+            if (s[0] - ax) * dx + (s[1] - ay) * dy + (s[2] - az) * dz >= length:
                 break
         return hits
 

@@ -42,10 +42,17 @@ def check_target(target: np.ndarray) -> np.ndarray:
 
 
 def check_seed(model: KinematicModel, seed_q: np.ndarray) -> np.ndarray:
-    """The seed as a float array brought into the limits (wrapped or clamped)."""
+    """The seed as a float array (a copy) brought into the limits (wrapped or clamped).
+
+    A seed already within the limits (the usual case: a measured or previous answer) is checked
+    with Python scalars and returned as copied; ``into_limits`` would leave its values as they are.
+    """
     q = np.array(seed_q, dtype=float).reshape(-1)
     if q.shape[0] != model.nq:
         raise RobocfgError(f"seed_q has {q.shape[0]} values; the arm has {model.nq} joints")
+    lo, hi = model.limit_lists
+    if all(a <= v <= b for a, v, b in zip(lo, q.tolist(), hi)):  # noqa: B905 - nq values each; False for NaN
+        return q
     if not np.isfinite(q).all():
         raise RobocfgError("seed_q contains NaN or infinite values")
     return into_limits(model, q)
@@ -90,8 +97,8 @@ def residuals(T: np.ndarray, target: np.ndarray) -> tuple[float, float]:
 
 def joints_at_limit(model: KinematicModel, q: np.ndarray) -> list[str]:
     """Names of the (non-wrapped) joints within LIMIT_TOL of a limit."""
-    return [n for n, v, lo, hi, w in zip(model.joint_names, q.tolist(), model.lower.tolist(),
-                                         model.upper.tolist(), model.wrap.tolist(), strict=True)
+    (lower, upper), wrap = model.limit_lists, model.wrap_list
+    return [n for n, v, lo, hi, w in zip(model.joint_names, q.tolist(), lower, upper, wrap, strict=True)
             if not w and (v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL)]
 
 
@@ -166,13 +173,19 @@ class Descent:
 
 
 def finish(km: KinematicModel, backend: str, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool,
-           tol_pos: float, tol_rot: float, t0: float, iters: int, restarts: int) -> IKResult:
-    """The IKResult for ``q``: residuals by FK (m, rad), convergence against the tolerances."""
-    pin.forwardKinematics(km.model, km.data, q)
-    d = pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)
-    pe = math.sqrt(d.translation.dot(d.translation))
-    w = pin.log3(d.rotation)
-    re = 0.0 if position_only else math.sqrt(w.dot(w))
+           tol_pos: float, tol_rot: float, t0: float, iters: int, restarts: int,
+           squared: tuple[float, float] | None = None) -> IKResult:
+    """The IKResult for ``q``: residuals by FK (m, rad), convergence against the tolerances.
+    ``squared``: (position², rotation²) already measured at ``q`` itself — the same FK and
+    logarithm (``log6``'s angular part is ``log3``), so the same floats — sparing a second FK."""
+    if squared is None:
+        pin.forwardKinematics(km.model, km.data, q)
+        d = pin.updateFramePlacement(km.model, km.data, fid).actInv(Mt)
+        pe = math.sqrt(d.translation.dot(d.translation))
+        w = pin.log3(d.rotation)
+        re = 0.0 if position_only else math.sqrt(w.dot(w))
+    else:
+        pe, re = math.sqrt(squared[0]), 0.0 if position_only else math.sqrt(squared[1])
     return IKResult(q=q, converged=bool(pe <= tol_pos and re <= tol_rot), pos_err=pe, rot_err=re,
                     iterations=iters, time_s=perf_counter() - t0, joints_at_limit=joints_at_limit(km, q),
                     backend=backend, restarts=restarts)

@@ -65,6 +65,8 @@ class LMSolver:
         self.stall_ratio, self.stall_n = stall_ratio, stall_n
         self.restart_candidates = restart_candidates
         self._eye = np.eye(model.nq)  # read only: the damping term's identity
+        # (q, position², rotation²) of each descent's best configuration in the current solve
+        self._measured: list[tuple[np.ndarray, float, float]] = []
 
     def solve(self, target: np.ndarray, seed_q: np.ndarray, frame: str = "tcp",
               time_budget: float = 0.02, position_only: bool = False,
@@ -77,10 +79,17 @@ class LMSolver:
         def descend(q: np.ndarray, deadline: float, cap: int | None) -> tuple[bool, int, float, np.ndarray]:
             return self._descend(q, Mt, fid, position_only, deadline, self.max_iter if cap is None else min(self.max_iter, cap))
 
+        self._measured = []
         best_q, iters, restarts = search(km, descend, q0, deadline, rng, self.clock, self.max_total_iter,
                                          lambda rng: self._restart(rng, Mt, fid, position_only), whole_first=True)
-        return finish(km, self.name, nearest_equivalent(km, best_q, q0), Mt, fid, position_only,
-                      self.tol_pos, self.tol_rot, t0, iters, restarts)
+        q = nearest_equivalent(km, best_q, q0)
+        # the residuals the descent measured at this very configuration, if it did: finish needs no FK
+        squared = next(((pe2, re2) for qm, pe2, re2 in self._measured if qm is best_q), None)
+        self._measured = []
+        if squared is not None and q is not best_q and not (q == best_q).all():
+            squared = None  # a wrapped joint moved by 2π: measure it again
+        return finish(km, self.name, q, Mt, fid, position_only, self.tol_pos, self.tol_rot, t0, iters, restarts,
+                      squared)
 
     def _restart(self, rng: np.random.Generator, Mt: pin.SE3, fid: int, position_only: bool) -> np.ndarray:
         """The best of ``restart_candidates`` uniform configurations (position + 0.1·rotation error)."""
@@ -102,7 +111,8 @@ class LMSolver:
 
     def _descend(self, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool, deadline: float,
                  max_iter: int | None = None):
-        """One damped descent from ``q``: (converged, iterations, best squared error, best q)."""
+        """One damped descent from ``q``: (converged, iterations, best squared error, best q); the
+        best q's squared residuals are noted in ``_measured`` (``finish`` reuses them)."""
         km = self.km
         model, data = km.model, km.data
         lower, upper, wrap = km.lower, km.upper, km.wrap
@@ -110,13 +120,15 @@ class LMSolver:
         tp2, tr2 = self.tol_pos**2, self.tol_rot**2
         mu, lam0 = self.mu, self.lambda0
         ratio, stall_n = self.stall_ratio, self.stall_n
-        eye = self._eye if self._eye.shape[0] == km.nq else np.eye(km.nq)
+        eye = self._eye if self._eye.shape[0] == model.nq else np.eye(model.nq)
         cjj, ufp, gfj, log6 = pin.computeJointJacobians, pin.updateFramePlacement, pin.getFrameJacobian, pin.log6
         mn, mx, nnz = np.minimum, np.maximum, np.count_nonzero
         clock = self.clock
         best_s, best_q, ref_s, stall = math.inf, q, math.inf, 0
+        best_pe2 = best_re2 = math.inf
         pinned = bool(nnz(q <= lower) or nnz(q >= upper))
         max_iter = self.max_iter if max_iter is None else max_iter
+        it = 0
         for it in range(1, max_iter + 1):
             cjj(model, data, q)
             d = ufp(model, data, fid).actInv(Mt)
@@ -131,15 +143,16 @@ class LMSolver:
                 re2 = w.dot(w)
             s = pe2 + re2
             if s < best_s:
-                best_s, best_q = s, q
+                best_s, best_q, best_pe2, best_re2 = s, q, pe2, re2
             if pe2 <= tp2 and re2 <= tr2:
+                self._measured.append((q, float(pe2), float(re2)))
                 return True, it, s, q
             if s < ref_s * ratio:
                 ref_s, stall = s, 0
             else:
                 stall += 1
                 if stall >= stall_n:
-                    return False, it, best_s, best_q
+                    break
             J = gfj(model, data, fid, _LOCAL)
             if position_only:
                 J = J[:3]
@@ -158,12 +171,18 @@ class LMSolver:
                     g[blk] = 0.0
                     dq = dposv(H, g)[1]
             qn = q + dq
-            if any_wrap:  # a wrapped joint leaving its (≥ 2π wide) range re-enters from the other side
-                over, under = (qn > upper) & wrap, (qn < lower) & wrap
-                if nnz(over) or nnz(under):
-                    qn = qn - TWO_PI * over + TWO_PI * under
             q = mn(mx(qn, lower), upper)
-            pinned = froze or bool(nnz(q != qn))
+            if nnz(q != qn):  # a joint left its limits (or NaN)
+                if any_wrap:  # a wrapped joint leaving its (≥ 2π wide) range re-enters from the other side
+                    over, under = (qn > upper) & wrap, (qn < lower) & wrap
+                    if nnz(over) or nnz(under):
+                        qn = qn - TWO_PI * over + TWO_PI * under
+                        q = mn(mx(qn, lower), upper)
+                pinned = froze or bool(nnz(q != qn))
+            else:
+                pinned = froze
             if clock() >= deadline:
-                return False, it, best_s, best_q
-        return False, max_iter, best_s, best_q
+                break
+        if best_pe2 != math.inf:
+            self._measured.append((best_q, float(best_pe2), float(best_re2)))
+        return False, it, best_s, best_q
