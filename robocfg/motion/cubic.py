@@ -69,29 +69,44 @@ class CubicSpline:
 
     def __call__(self, xs, nu: int = 0) -> np.ndarray:
         """Values (nu = 0) or the ``nu``-th derivative at ``xs``: shape ``xs.shape + (n,)``."""
+        return self.derivatives(xs, (nu,))[0]
+
+    def derivatives(self, xs, nus: tuple[int, ...]) -> list[np.ndarray]:
+        """``[spline(xs, nu) for nu in nus]``, the same values bit for bit, with the pieces'
+        lookup, their coefficients at ``xs`` and the powers of the local coordinate made once."""
         xs = np.asarray(xs, dtype=np.float64)
         flat = xs.ravel()
-        i = np.clip(np.searchsorted(self.x, flat, side="right") - 1, 0, len(self.x) - 2)
+        # np.clip's bounds checks cost more than the search on these small arrays; the same ints
+        i = np.minimum(np.maximum(np.searchsorted(self.x, flat, side="right") - 1, 0), len(self.x) - 2)
         s = (flat - self.x[i])[:, None]
         order = self.c.shape[0]
-        res: np.ndarray | None = None
-        z: np.ndarray | None = None  # s**(kp - nu); None stands for scipy's exact 1.0
-        for kp in range(nu, order):
-            prefactor = 1.0
-            for k in range(kp, kp - nu, -1):
-                prefactor *= k
-            term = self.c[order - kp - 1][i]  # scipy: res = res + c * z * prefactor (x * 1.0 is x, bit for bit)
-            if z is not None:
-                term = term * z
-            if prefactor != 1.0:
-                term = term * prefactor
-            res = term + 0.0 if res is None else res + term  # scipy starts from res = 0.0
-            if kp < order - 1:
-                z = s if z is None else z * s
-        if res is None:
-            res = np.zeros((len(flat), self.c.shape[2]))
-        res[np.isnan(flat)] = np.nan  # scipy: NaN in, NaN out (every derivative)
-        return res.reshape(*xs.shape, self.c.shape[2])
+        coef: list[np.ndarray | None] = [None] * order  # the coefficient of s**kp at each point, gathered when first needed
+        powers: list[np.ndarray | None] = [None]  # s**m built as (s*s)*s...; None stands for scipy's exact 1.0
+        nan = np.isnan(flat)
+        out = []
+        for nu in nus:
+            res: np.ndarray | None = None
+            for kp in range(nu, order):
+                prefactor = 1.0
+                for k in range(kp, kp - nu, -1):
+                    prefactor *= k
+                term = coef[kp]
+                if term is None:
+                    term = coef[kp] = self.c[order - kp - 1][i]
+                m = kp - nu  # scipy: res = res + c * z * prefactor, z = s**m (x * 1.0 is x, bit for bit)
+                while len(powers) <= m:
+                    powers.append(s if len(powers) == 1 else powers[-1] * s)
+                z = powers[m]
+                if z is not None:
+                    term = term * z
+                if prefactor != 1.0:
+                    term = term * prefactor
+                res = term + 0.0 if res is None else res + term  # scipy starts from res = 0.0
+            if res is None:
+                res = np.zeros((len(flat), self.c.shape[2]))
+            res[nan] = np.nan  # scipy: NaN in, NaN out (every derivative)
+            out.append(res.reshape(*xs.shape, self.c.shape[2]))
+        return out
 
 
 def _solve_tridiagonal(A: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -36,6 +36,10 @@ class _Segment:
             return np.broadcast_to(self.delta, (*s.shape, len(self.delta))).copy()
         return np.zeros((*s.shape, len(self.delta)))
 
+    def derivatives(self, s, nus: tuple[int, ...]) -> list[np.ndarray]:
+        """``[self(s, nu) for nu in nus]`` (the interface of :meth:`CubicSpline.derivatives`)."""
+        return [self(s, nu) for nu in nus]
+
 
 class MinJerkPath(Trajectory):
     """q(t) = spline(s(t / T)), rest to rest, through ``waypoints`` (k, n) with k ≥ 2 (two: the
@@ -62,8 +66,8 @@ class MinJerkPath(Trajectory):
             knots /= knots[-1]
             self.spline = CubicSpline(knots, W, axis=0, bc_type="not-a-knot" if len(W) > 3 else "natural")
             s = np.linspace(0.0, 1.0, SAMPLES)
-            d1 = np.abs(self.spline(s, 1)).max(axis=0)
-            d2 = np.abs(self.spline(s, 2)).max(axis=0)
+            v1, v2 = self.spline.derivatives(s, (1, 2))
+            d1, d2 = np.abs(v1).max(axis=0), np.abs(v2).max(axis=0)
         t_vel = PEAK_SPEED * np.max(d1 / limits.velocity)
         t_acc = np.sqrt(np.max((d2 * PEAK_SPEED**2 + d1 * PEAK_ACCEL) / limits.acceleration))
         self.duration = float(max(t_vel, t_acc, min_duration))
@@ -74,7 +78,8 @@ class MinJerkPath(Trajectory):
         tau = np.clip(tt / self.duration, 0.0, 1.0)
         s = tau**3 * (10 - 15 * tau + 6 * tau**2)
         sd = 30 * tau**2 * (1 - tau) ** 2 / self.duration
-        return self.spline(s), self.spline(s, 1) * sd[:, None]
+        q, d1 = self.spline.derivatives(s, (0, 1))
+        return q, d1 * sd[:, None]
 
     def _eval(self, t):
         T = self.duration
@@ -82,7 +87,5 @@ class MinJerkPath(Trajectory):
         s = tau**3 * (10 - 15 * tau + 6 * tau**2)
         sd = 30 * tau**2 * (1 - tau) ** 2 / T
         sdd = 60 * tau * (1 - tau) * (1 - 2 * tau) / T**2
-        q = self.spline(s)
-        d1 = self.spline(s, 1)
-        d2 = self.spline(s, 2)
+        q, d1, d2 = self.spline.derivatives(s, (0, 1, 2))
         return q, d1 * sd[:, None], d2 * sd[:, None] ** 2 + d1 * sdd[:, None]

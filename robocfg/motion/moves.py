@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from copy import copy
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -99,7 +100,9 @@ class ArmMover:
         res = self._answers.get(key)
         if res is None:
             res = self._answers[key] = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
-        return replace(res, q=res.q.copy())  # callers may keep or change their copy
+        out = copy(res)  # callers may keep or change their copy
+        out.q = res.q.copy()
+        return out
 
     def solve(self, T: np.ndarray, seed: np.ndarray, what: str = "") -> np.ndarray:
         res = self.ik(T, seed)
