@@ -94,7 +94,8 @@ class ArmMover:
         """IK of the EE pose ``T`` (4x4, world) from ``seed`` (rad or m), remembered for the mover's
         life (one episode) under the exact bytes of both: the grasp choice and the moves after it
         ask some of the same questions (the pre-grasp pose from the same joints), and the solver's
-        answer depends on nothing else (an iteration budget, a fixed restart seed)."""
+        answer depends on nothing else (an iteration budget, a fixed restart seed). The waypoints
+        of straight lines are solved directly (each from its neighbour: never asked twice)."""
         T, seed = np.asarray(T, dtype=float), np.asarray(seed, dtype=float)
         key = (T.tobytes(), seed.tobytes())
         res = self._answers.get(key)
@@ -120,11 +121,14 @@ class ArmMover:
         p0, p1 = T0[:3, 3], T_goal[:3, 3]
         n = max(2, math.ceil(np.linalg.norm(p1 - p0) / CARTESIAN_STEP) + 1)
         waypoints, q = [q0], q0
-        ik = self.ik
-        for s in np.linspace(0, 1, n)[1:]:
+        # straight to the solver, not through the answers remembered by self.ik: the points of a
+        # line are asked from the line's own previous answer, never twice in an episode
+        ik, budget = self.model.ik, self.ik_budget
+        (x0, y0, z0), (x1, y1, z1) = p0.tolist(), p1.tolist()
+        for s in np.linspace(0, 1, n)[1:].tolist():
             T = T_goal.copy()
-            T[:3, 3] = (1 - s) * p0 + s * p1
-            res = ik(T, q)  # self.solve, its message made on failure only
+            T[:3, 3] = ((1 - s) * x0 + s * x1, (1 - s) * y0 + s * y1, (1 - s) * z0 + s * z1)  # as the arrays would
+            res = ik(T, seed_q=q, frame="ee", time_budget=budget)  # self.solve, its message made on failure only
             if not res.converged:
                 raise self._unreachable(res, f" at {s:.0%} of the straight line")
             q_next = res.q
