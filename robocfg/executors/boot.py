@@ -1,6 +1,10 @@
-"""First module a process-pool fork server imports: pybullet without its build banner (the fork
-server's other preloads import it, and the banner would land in the user's terminal)."""
+"""First module a process-pool fork server imports: one math-library thread for it and its workers
+(before numpy is imported: :mod:`robocfg.executors.worker_setup`), and pybullet without its build
+banner (the fork server's other preloads import it, and the banner would land in the user's
+terminal)."""
 
+from robocfg.executors.worker_setup import single_threaded_env
 from robocfg.sim.quiet import quiet_import
 
+single_threaded_env()
 quiet_import()

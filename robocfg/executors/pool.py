@@ -7,6 +7,8 @@ with the way it died, its remaining work goes to the others, and the run never h
 come from a fork server that has imported the recipe's modules once (no threads in it, so
 forking is safe even when the driver runs Ray or a progress-bar thread), and ignore SIGINT: the
 driver decides, on the first Ctrl-C, to hand out nothing more and collect what is running.
+Each worker first sets up its own process (:mod:`robocfg.executors.worker_setup`: one math-library
+thread, as a worker is one core's worth of work; optionally pinned to a core).
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from robocfg.executors.session import (
     run_batch,
     worker_start,
 )
+from robocfg.executors.worker_setup import WorkerSetup, apply
 
 POLL = 0.5  # s: how often the driver looks at the stop request while waiting
 JOIN_TIMEOUT = 10.0  # s the finished workers get, together, to exit before they are terminated
@@ -44,14 +47,15 @@ class WorkerError(RobocfgError):
     """A worker raised (not a failed episode: those are records) — e.g. the world cannot be built."""
 
 
-def _worker_main(conn: Connection, recipe: Recipe) -> None:
-    """A worker: open the recipe once, then run the batches it is sent (and make the report when
-    asked) until it is sent None."""
+def _worker_main(conn: Connection, recipe: Recipe, setup: WorkerSetup, index: int) -> None:
+    """Worker ``index``: set up its process, open the recipe once, then run the batches it is sent
+    (and make the report when asked) until it is sent None."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     opening = time.time()
     try:
+        set_up = apply(setup, index)
         session = recipe.open()
-        conn.send(("ready", worker_start(opening)))  # the world is built: what ProcessPool.start waits for
+        conn.send(("ready", worker_start(opening, set_up)))  # the world is built: what ProcessPool.start waits for
         try:
             while (msg := conn.recv()) is not None:
                 if isinstance(msg, ReportRequest):
@@ -79,10 +83,11 @@ class _Worker:
 class ProcessPool:
     """Run a recipe's episodes on ``workers`` local processes (see the module docstring)."""
 
-    def __init__(self, workers: int):
+    def __init__(self, workers: int, setup: WorkerSetup | None = None):
         if workers < 1:
             raise RobocfgError(f"--workers {workers}: need at least 1")
         self.workers = workers
+        self.setup = setup if setup is not None else WorkerSetup()  # how each worker sets up its process
         self.pids: list[int] = []  # the worker processes' ids, once started
         self.starts: list[WorkerStart] = []  # how each worker started, filled by start()
         self._started: tuple[Recipe, list[_Worker]] | None = None
@@ -115,9 +120,9 @@ class ProcessPool:
         ctx = mp.get_context("forkserver")
         ctx.set_forkserver_preload(["robocfg.executors.boot", "robocfg.executors.pool", *recipe.preload])
         pool: list[_Worker] = []
-        for _ in range(count):
+        for i in range(count):
             parent, child = ctx.Pipe()
-            proc = ctx.Process(target=_worker_main, args=(child, recipe), daemon=True)
+            proc = ctx.Process(target=_worker_main, args=(child, recipe, self.setup, i), daemon=True)
             proc.start()
             child.close()
             pool.append(_Worker(proc, parent))

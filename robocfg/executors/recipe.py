@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from robocfg.executors.session import DatasetTarget, EpisodeRun
+from robocfg.executors.usage import Usage
 
 if TYPE_CHECKING:
     from robocfg.datasets.sink import DatasetSink
@@ -93,11 +94,12 @@ class EngineSession:
     def run(self, k: int, sink: DatasetSink | None = None) -> EpisodeRun:
         if self.switch is not None:
             self.switch.target = sink
-        cpu, thread = time.process_time(), time.thread_time()
+        usage, cpu, thread = Usage.now(), time.process_time(), time.thread_time()
         record = self.session.run(k)
         cpu, thread = time.process_time() - cpu, time.thread_time() - thread
+        usage = Usage.now() - usage
         t = self.session.timing
-        return EpisodeRun(record, t.per_episode[-1], t.physics_per_episode[-1], cpu, thread)
+        return EpisodeRun(record, t.per_episode[-1], t.physics_per_episode[-1], cpu, thread, usage)
 
     def report(self, records: list[Any], interrupted: bool) -> Any:
         return self.session.report(records, interrupted)

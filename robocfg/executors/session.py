@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from robocfg.datasets.episode import Actions
     from robocfg.datasets.shards import Shard
     from robocfg.datasets.sink import DatasetSink, Format, Keep
+    from robocfg.executors.usage import Usage
+    from robocfg.executors.worker_setup import SetupDone
     from robocfg.sim.camera_rig import Renderer
 
 
@@ -71,13 +73,15 @@ class EpisodeRun:
     stepping the physics (s); ``cpu``: the worker process's CPU time over the episode (s, user +
     system, every thread: a Ray actor's own threads included), ``thread_cpu``: the part on the
     thread that ran it (s). CPU times do not count time spent waiting for a core, so they compare
-    executors on a loaded machine where wall times do not."""
+    executors on a loaded machine where wall times do not. ``usage``: the process's resource use
+    over the episode (user and system CPU, page faults, context switches; None where not taken)."""
 
     record: Any
     wall: float
     physics: float
     cpu: float = 0.0
     thread_cpu: float = 0.0
+    usage: Usage | None = None
 
     @property
     def index(self) -> int:
@@ -144,21 +148,27 @@ class WorkerStart:
     """When a worker started (wall clock, s since the epoch): its process was created
     (``created``), it began opening the recipe (``opening``: the interpreter, its imports and the
     recipe's unpickling done) and its session was open (``ready``: world, model and controllers
-    built); ``niceness``: its scheduling niceness (a higher one yields the CPU to other processes)."""
+    built); ``niceness``: its scheduling niceness (a higher one yields the CPU to other processes);
+    ``threads``: the process's threads then (0: unknown); ``setup``: what a pool worker did to its
+    process first (:mod:`robocfg.executors.worker_setup`; None: nothing, as in a Ray actor)."""
 
     pid: int
     created: float
     opening: float
     ready: float
     niceness: int = 0
+    threads: int = 0
+    setup: SetupDone | None = None
 
 
-def worker_start(opening: float) -> WorkerStart:
+def worker_start(opening: float, setup: SetupDone | None = None) -> WorkerStart:
     """This process's :class:`WorkerStart`, its session having opened just now."""
     import os
     import time
 
-    return WorkerStart(os.getpid(), _created(), opening, time.time(), os.nice(0))
+    from robocfg.executors.usage import thread_count
+
+    return WorkerStart(os.getpid(), _created(), opening, time.time(), os.nice(0), thread_count(), setup)
 
 
 def _created() -> float:
