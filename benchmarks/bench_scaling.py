@@ -2,7 +2,8 @@
 interleaved rounds.
 
     python benchmarks/bench_scaling.py [--workers 1,2,4,8,16] [--per-worker 16] [--rounds 5] [--ray]
-                                       [--ray-kept] [--dataset] [--no-in-process] [--json out.json]
+                                       [--ray-kept] [--pool-variants single,default,pin,malloc]
+                                       [--dataset] [--no-in-process] [--json out.json]
 
 Weak scaling: a run of worker count w runs ``per-worker × w`` episodes of the shipped pick-place task
 without cameras (seed 0) through the executors the CLI uses (``--workers``: a process pool;
@@ -46,6 +47,12 @@ What a run measures, each part apart:
   every other process it started (fork server; Ray's raylet, GCS, agents and idle workers) during
   the run ÷ episodes (needs psutil). ``cpu ms/ep`` is their sum: the machine's CPU per episode.
 
+``--pool-variants``: the pool with other worker set-ups (math-library threads as the libraries'
+default, pinned workers, glibc malloc settings) as further executors in the same rounds, and what
+an episode costs its process at each worker count (main thread vs process CPU, user vs system,
+page faults, context switches, the machine's steal time): ``benchmarks/_scaling_usage.py`` says
+what each column means.
+
 *Core speed* (printed first): a fixed pure-Python loop's CPU time alone ÷ with w copies at once
 — what the machine's cores give when w of them are busy (turbo limits, shared caches), the part of
 the *cpu* factor below that no executor can change.
@@ -77,7 +84,10 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from _scaling_usage import CpuTimes, pool_kinds, setup_of, usage_table, variant_table
+
 RAY_KINDS = ("ray", "ray-kept")  # Ray actors started for each run (as the CLI does), kept actors reused
+POOL_KINDS = ("pool", "pool-default", "pool-pin", "pool-malloc")  # --pool-variants (_scaling_usage)
 
 
 @dataclass
@@ -101,6 +111,11 @@ class Sample:
     first_cpu: float = float("nan")  # median over workers: CPU of each worker's first episode
     niceness: list[int] = field(default_factory=list)  # the workers' scheduling niceness
     time_line: TimeLine | None = None  # where the run's worker-seconds went
+    first_thread_cpu: float = float("nan")  # the same, the episode's thread only
+    usage: list = field(default_factory=list)  # per episode: robocfg.executors.usage.Usage (None: not taken)
+    threads: list[int] = field(default_factory=list)  # each worker's threads once its world was built
+    steal_pct: float = float("nan")  # the machine's steal time over the run, % of all CPUs' time
+    busy_pct: float = float("nan")  # the machine's non-idle time over the run, % of all CPUs' time
 
     @property
     def eps(self) -> float:
@@ -237,16 +252,18 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
 
     target = _target(dataset, task)
     recipe = EngineRecipe.of(task, RunOptions(seed=0, episodes=episodes), target)
-    pool = RayPool(workers, keep=kind == "ray-kept") if kind in RAY_KINDS else ProcessPool(workers)
+    pool = RayPool(workers, keep=kind == "ray-kept") if kind in RAY_KINDS else ProcessPool(workers, setup_of(kind))
     asked = time.time()
     t0 = time.perf_counter()
     pool.start(recipe)
     t1 = time.perf_counter()
     pids = {s.pid for s in pool.starts}
     before = tree.snapshot(pids)
+    machine = CpuTimes.now()
     called = time.time()
     out = pool.run(recipe, plan_batches(episodes, workers, target is not None))
     returned = time.time()
+    steal, busy = CpuTimes.now().since(machine)
     if target is not None:
         MergedShards(out.shards, target.root, target.fmt, target.extra_info).close()
     t2 = time.perf_counter()
@@ -258,10 +275,11 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
         first[b.pid] = min(first.get(b.pid, math.inf), b.cpu[0])
         last[b.pid] = max(last.get(b.pid, -math.inf), b.cpu[1])
     runs = out.runs
-    firsts = {}
+    firsts, first_threads = {}, {}
     for b in sorted(out.done, key=lambda b: b.cpu[0]):
         if b.runs:
             firsts.setdefault(b.pid, b.runs[0].cpu)
+            first_threads.setdefault(b.pid, b.runs[0].thread_cpu)
     return Sample(kind, workers, rnd, episodes, t1 - t0, t2 - t1, out.report.summary.successes,
                   statistics.median(s.opening - asked for s in pool.starts),
                   statistics.median(s.created - asked for s in pool.starts),
@@ -270,7 +288,9 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
                   sum(last[p] - first[p] for p in first), tree.between(before, after),
                   statistics.median(firsts.values()), [s.niceness for s in pool.starts],
                   TimeLine.of(out.done, called, returned, len(pool.starts))
-                  if all(hasattr(b, "wall") for b in out.done) else None)  # older robocfg: no stamps
+                  if all(hasattr(b, "wall") for b in out.done) else None,  # older robocfg: no stamps
+                  statistics.median(first_threads.values()), [getattr(r, "usage", None) for r in runs],
+                  [getattr(s, "threads", 0) for s in pool.starts], steal, busy)
 
 
 def _settle(tree: TreeCpu, limit: float = 30.0) -> float:
@@ -409,9 +429,9 @@ def rounds_needed(ratios: list[float], half_width: float = 0.05) -> int | None:
 def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
     """Print the tables; return them as JSON-ready data."""
     by = {(s.executor, s.workers, s.round): s for s in samples}
-    kinds = [k for k in ("in-process", "pool", *RAY_KINDS) if any(s.executor == k for s in samples)]
+    kinds = [k for k in ("in-process", *POOL_KINDS, *RAY_KINDS) if any(s.executor == k for s in samples)]
     ray_kinds = [k for k in RAY_KINDS if k in kinds] or ["ray"]
-    print(f"\n{'executor':<11}{'w':>3}{'eps':>5}{'steady ep/s':>12}{'±%':>5}{'ep/s+start':>11}{'start s':>8}"
+    print(f"\n{'executor':<13}{'w':>3}{'eps':>5}{'steady ep/s':>12}{'±%':>5}{'ep/s+start':>11}{'start s':>8}"
           f"{'spawn s':>8}{'boot s':>7}{'build s':>8}{'episode ms':>11}{'±%':>5}{'1st ms':>7}{'worker ms/ep':>13}{'driver+ ms/ep':>14}"
           f"{'cpu ms/ep':>10}{'ok':>9}")
     table = []
@@ -426,7 +446,7 @@ def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
             cpu = [s.cpu_per_episode for s in rows]
             ok = f"{sum(s.successes for s in rows)}/{sum(s.episodes for s in rows)}"
             ep_med = [statistics.median(s.episode_cpu) for s in rows if s.episode_cpu]
-            print(f"{kind:<11}{w:>3}{rows[0].episodes:>5}{_med([s.eps for s in rows]):>12.3f}"
+            print(f"{kind:<13}{w:>3}{rows[0].episodes:>5}{_med([s.eps for s in rows]):>12.3f}"
                   f"{_pct([s.eps for s in rows]):>5}{_med([s.eps_with_start for s in rows]):>11.3f}"
                   f"{_med([s.start_s for s in rows]):>8.2f}{_med([s.spawn_s for s in rows]):>8.2f}"
                   f"{_med([s.boot_s for s in rows]):>7.2f}"
@@ -474,7 +494,10 @@ def summarise(samples: list[Sample], counts: list[int], rounds: int) -> dict:
     if any(p["ray_over_pool"] for p in paired):
         print("(ray/pool episode cpu: Ray's median CPU per episode ÷ the pool's, > 1 = Ray's episodes cost more;"
               " ray/pool cpu/ep: the pool's machine CPU per episode ÷ Ray's, < 1 = Ray costs more in all)")
-    return {"rows": table, "paired": paired, **where_time_goes(samples, counts, rounds)}
+    where = where_time_goes(samples, counts, rounds)
+    executors = [k for k in kinds if k != "in-process"]
+    return {"rows": table, "paired": paired, **where, "usage": usage_table(samples, executors, counts),
+            "variants": variant_table(samples, executors, counts, rounds)}
 
 
 def _factors(a: Sample, b: Sample) -> tuple[float, float, float] | None:
@@ -497,10 +520,10 @@ def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> di
     """Print where each run's worker-seconds went (:class:`TimeLine`) and the efficiency and Ray ÷
     pool split into factors (:func:`_factors`); return both as JSON-ready data."""
     print("\nWhere the workers' time went (% of workers × run s; medians over the rounds):")
-    print(f"{'executor':<10}{'w':>3}{'run s':>7}{'episodes':>9}{'had core':>9}{'lead':>7}{'batch':>7}{'gaps':>7}"
+    print(f"{'executor':<13}{'w':>3}{'run s':>7}{'episodes':>9}{'had core':>9}{'lead':>7}{'batch':>7}{'gaps':>7}"
           f"{'ms/gap':>7}{'imbal.':>7}{'end':>7}{'end ms':>7}")
     rows = []
-    for kind in ("pool", *RAY_KINDS):
+    for kind in (*POOL_KINDS, *RAY_KINDS):
         for w in counts:
             runs = [s for s in samples if s.executor == kind and s.workers == w and s.time_line is not None]
             if not runs:
@@ -511,7 +534,7 @@ def where_time_goes(samples: list[Sample], counts: list[int], rounds: int) -> di
             had_core = [100 * t.episode_cpu / t.episodes for t in tl if t is not None]
             ms_gap = [1e3 * t.gaps / t.n_gaps for t in tl if t is not None and t.n_gaps]
             end_ms = [1e3 * t.end / w for t in tl if t is not None]
-            print(f"{kind:<10}{w:>3}{_med([s.run_s for s in runs]):>7.2f}{_med(share['episodes']):>9.1f}"
+            print(f"{kind:<13}{w:>3}{_med([s.run_s for s in runs]):>7.2f}{_med(share['episodes']):>9.1f}"
                   f"{_med(had_core):>9.1f}{_med(share['lead']):>7.1f}{_med(share['batch']):>7.1f}{_med(share['gaps']):>7.1f}"
                   f"{_med(ms_gap):>7.2f}{_med(share['imbalance']):>7.1f}{_med(share['end']):>7.1f}{_med(end_ms):>7.0f}")
             rows.append({"executor": kind, "workers": w, "percent": share, "had_core_percent": had_core,
@@ -564,6 +587,10 @@ def main() -> None:
                     help="also run each worker count on kept Ray actors (RayPool(keep=True): processes reused across runs)")
     ap.add_argument("--ray-worker-niceness", type=int, default=None,
                     help="niceness of the local Ray's workers (default: robocfg's, 0; Ray's own default is 15)")
+    ap.add_argument("--pool-variants", default="single",
+                    help="pool worker set-ups run side by side: single (what --workers does), default (math "
+                         "libraries' own thread count: the old pool), pin (workers bound to cores), malloc "
+                         "(glibc mmap/trim thresholds raised); e.g. single,default,pin")
     ap.add_argument("--dataset", action="store_true", help="record a state-only LeRobot dataset (shards merged)")
     ap.add_argument("--no-in-process", action="store_true", help="skip the in-process reference row")
     ap.add_argument("--json", default=None)
@@ -596,8 +623,8 @@ def main() -> None:
           + ", ".join(f"w={w} {f:.2f}" for w, f in speed.items()))
     tree = TreeCpu()
     samples = [] if args.no_in_process else [in_process(task, args.per_worker, ds())]
-    kinds = ["pool", *(["ray"] if args.ray else []), *(["ray-kept"] if args.ray_kept else [])]
-    if len(kinds) > 1:
+    kinds = [*pool_kinds(args.pool_variants), *(["ray"] if args.ray else []), *(["ray-kept"] if args.ray_kept else [])]
+    if any(k in RAY_KINDS for k in kinds):
         import ray
 
         from robocfg.executors import ray_pool
@@ -606,7 +633,7 @@ def main() -> None:
             ray_pool.WORKER_NICENESS = args.ray_worker_niceness
         # Ray CPUs are counted, not bound: kept actors hold theirs while idle, so fresh actors beside
         # them need as many again
-        ray_cpus = max(counts) * (len(kinds) - 1)
+        ray_cpus = max(counts) * sum(k in RAY_KINDS for k in kinds)
         ray_pool.init_ray(ray, num_cpus=ray_cpus)
         waited = _settle(TreeCpu())
         print(f"local Ray {ray.__version__} started with num_cpus={ray_cpus} before any timing"
@@ -620,10 +647,10 @@ def main() -> None:
                 samples.append(s)
                 if rnd == 0 and w == counts[0]:
                     print(f"  {kind} workers' niceness: {sorted(set(s.niceness))} (driver: {os.nice(0)})")
-                print(f"  round {rnd} {kind:<8} w={w:<2} start {s.start_s:5.2f} s  run {s.run_s:6.2f} s  "
+                print(f"  round {rnd} {kind:<12} w={w:<2} start {s.start_s:5.2f} s  run {s.run_s:6.2f} s  "
                       f"{s.eps:6.3f} ep/s  episode cpu {1e3 * statistics.median(s.episode_cpu):4.0f} ms  "
                       f"load {os.getloadavg()[0]:.2f}  (waited {settled:.1f} s for quiet before it)", flush=True)
-    if len(kinds) > 1:
+    if any(k in RAY_KINDS for k in kinds):
         import ray
 
         from robocfg.executors.ray_pool import release_kept
