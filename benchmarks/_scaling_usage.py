@@ -24,7 +24,8 @@ builds what is built lazily, counted too):
   another runnable thread got the core) context switches;
 * ``1st proc/main`` — the workers' first episodes, process vs main thread (math threads spinning
   show there);
-* ``threads`` — the worker's threads when its world was built (median over workers);
+* ``threads`` — the worker's threads when its world was built (median over workers); ``math`` —
+  the most threads a math library loaded in it may use then (OpenBLAS's count: 1 = single);
 * ``steal %`` — the machine's steal time over the run (``/proc/stat``: time a virtual CPU was
   ready but its host ran something else) in % of all CPUs' time; ``busy %`` — the machine's
   non-idle time over the run in % of all CPUs' time (every process, not only the workers).
@@ -93,7 +94,7 @@ def usage_table(samples: list, kinds: list[str], counts: list[int]) -> list[dict
     worker count; return the rows as JSON-ready data."""
     print("\nWhat an episode cost its worker process (medians over episodes; steal, busy: medians over the rounds):")
     print(f"{'executor':<13}{'w':>3}{'proc ms':>8}{'main ms':>8}{'other':>6}{'user ms':>8}{'sys ms':>7}{'minflt':>7}"
-          f"{'vcsw':>6}{'ivcsw':>6}{'1st proc/main':>14}{'threads':>8}{'steal %':>8}{'busy %':>7}")
+          f"{'vcsw':>6}{'ivcsw':>6}{'1st proc/main':>14}{'threads':>8}{'math':>5}{'steal %':>8}{'busy %':>7}")
     rows = []
     for kind in kinds:
         for w in counts:
@@ -112,15 +113,17 @@ def usage_table(samples: list, kinds: list[str], counts: list[int]) -> list[dict
                    "first_proc_ms": 1e3 * _med([s.first_cpu for s in runs]),
                    "first_main_ms": 1e3 * _med([s.first_thread_cpu for s in runs]),
                    "threads": _med([t for s in runs for t in s.threads]),
+                   "math_threads": _med([t for s in runs for t in s.math_threads]),
                    "steal_pct": [s.steal_pct for s in runs], "busy_pct": [s.busy_pct for s in runs]}
             rows.append(row)
             print(f"{kind:<13}{w:>3}{row['proc_ms']:>8.1f}{row['main_ms']:>8.1f}{row['other_ms']:>6.1f}"
                   f"{row['user_ms']:>8.1f}{row['sys_ms']:>7.1f}{row['minflt']:>7.0f}{row['nvcsw']:>6.0f}{row['nivcsw']:>6.0f}"
-                  f"{row['first_proc_ms']:>8.0f}/{row['first_main_ms']:<5.0f}{row['threads']:>8.0f}"
+                  f"{row['first_proc_ms']:>8.0f}/{row['first_main_ms']:<5.0f}{row['threads']:>8.0f}{row['math_threads']:>5.0f}"
                   f"{_med(row['steal_pct']):>8.2f}{_med(row['busy_pct']):>7.1f}")
     print("(proc: the worker process's CPU; main: the episode's thread; other: proc − main; user/sys: the process's"
           " user and system CPU; minflt: minor page faults; vcsw/ivcsw: voluntary/involuntary context switches;"
-          " 1st: each worker's first episode; threads: the worker's threads once its world was built;"
+          " 1st: each worker's first episode; threads: the worker's threads once its world was built; math: its math"
+          " libraries' thread count then;"
           " steal/busy: the machine's steal and non-idle time over the run, % of all CPUs)")
     return rows
 

@@ -55,7 +55,8 @@ what each column means.
 
 *Core speed* (printed first): a fixed pure-Python loop's CPU time alone ÷ with w copies at once
 — what the machine's cores give when w of them are busy (turbo limits, shared caches), the part of
-the *cpu* factor below that no executor can change.
+the *cpu* factor below that no executor can change; *memory speed*: the same for sums over a
+32 MiB array (memory bandwidth per core with w busy).
 
 Before each run the benchmark waits (up to 10 s, printed) until the processes under it use under
 half a core: the previous run's workers leaving and Ray starting idle workers to replace killed
@@ -114,6 +115,7 @@ class Sample:
     first_thread_cpu: float = float("nan")  # the same, the episode's thread only
     usage: list = field(default_factory=list)  # per episode: robocfg.executors.usage.Usage (None: not taken)
     threads: list[int] = field(default_factory=list)  # each worker's threads once its world was built
+    math_threads: list[int] = field(default_factory=list)  # each worker's math-library thread count then
     steal_pct: float = float("nan")  # the machine's steal time over the run, % of all CPUs' time
     busy_pct: float = float("nan")  # the machine's non-idle time over the run, % of all CPUs' time
 
@@ -290,7 +292,8 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
                   TimeLine.of(out.done, called, returned, len(pool.starts))
                   if all(hasattr(b, "wall") for b in out.done) else None,  # older robocfg: no stamps
                   statistics.median(first_threads.values()), [getattr(r, "usage", None) for r in runs],
-                  [getattr(s, "threads", 0) for s in pool.starts], steal, busy)
+                  [getattr(s, "threads", 0) for s in pool.starts], steal, busy,
+                  [getattr(s, "math_threads", 0) for s in pool.starts])
 
 
 def _settle(tree: TreeCpu, limit: float = 30.0) -> float:
@@ -315,11 +318,26 @@ def _spin(n: int) -> float:
     return time.process_time() - t
 
 
-def core_speed(counts: list[int], n: int = 3_000_000) -> dict[int, float]:
-    """For each worker count w: the CPU time of a fixed pure-Python loop alone ÷ its median CPU time
-    with w copies running at once in w processes (1.0: a core is as fast with w busy; < 1: cores
-    slow down when many are busy — turbo limits, shared caches, hyper-threads — which no executor
-    changes). Processes from the same fork server the pool uses."""
+def _stream(n: int) -> float:
+    """CPU time (s) of ``n`` sums over a 32 MiB array in this process (memory-bound: the data comes
+    from memory, not from a core's caches, on every pass)."""
+    import numpy as np
+
+    a = np.ones(4 << 20)
+    a.sum()
+    t = time.process_time()
+    for _ in range(n):
+        a.sum()
+    return time.process_time() - t
+
+
+def core_speed(counts: list[int], n: int = 3_000_000, kernel=_spin) -> dict[int, float]:
+    """For each worker count w: the CPU time of a fixed kernel alone ÷ its median CPU time with w
+    copies running at once in w processes (1.0: a core is as fast with w busy; < 1: cores slow
+    down when many are busy — turbo limits, shared caches, hyper-threads, memory bandwidth — which
+    no executor changes). ``kernel``: a pure-Python loop (:func:`_spin`, ``n`` iterations: the
+    core itself) or sums over a large array (:func:`_stream`, ``n`` passes: memory bandwidth).
+    Processes from the same fork server the pool uses."""
     import multiprocessing as mp
 
     ctx = mp.get_context("forkserver")
@@ -327,9 +345,9 @@ def core_speed(counts: list[int], n: int = 3_000_000) -> dict[int, float]:
     alone = None
     for w in sorted(set(counts)):
         with ctx.Pool(w) as p:
-            p.map(_spin, [n // 20] * w)  # all started and warm
+            p.map(kernel, [max(1, n // 20)] * w)  # all started and warm
             # the least disturbed of three tries (another tenant's burst makes a try slower)
-            cpu = min(statistics.median(p.map(_spin, [n] * w, chunksize=1)) for _ in range(3))
+            cpu = min(statistics.median(p.map(kernel, [n] * w, chunksize=1)) for _ in range(3))
         alone = cpu if alone is None else alone
         out[w] = alone / cpu
     return out
@@ -619,8 +637,11 @@ def main() -> None:
     print(f"start to an open session: fresh process {fresh:.2f} s, pool worker {warm:.2f} s "
           f"(first pool of this process, fork server start included: {first:.2f} s)")
     speed = core_speed(counts)
+    memory = core_speed(counts, 40, _stream)
     print("core speed with w processes busy (a fixed pure-Python loop's CPU time alone ÷ with w at once): "
           + ", ".join(f"w={w} {f:.2f}" for w, f in speed.items()))
+    print("memory speed with w processes busy (sums over a 32 MiB array, CPU time alone ÷ with w at once): "
+          + ", ".join(f"w={w} {f:.2f}" for w, f in memory.items()))
     tree = TreeCpu()
     samples = [] if args.no_in_process else [in_process(task, args.per_worker, ds())]
     kinds = [*pool_kinds(args.pool_variants), *(["ray"] if args.ray else []), *(["ray-kept"] if args.ray_kept else [])]
@@ -661,7 +682,8 @@ def main() -> None:
     print(f"load average: {load0:.2f} before, {os.getloadavg()[0]:.2f} after")
     if args.json:
         Path(args.json).write_text(json.dumps({"cores": cores, "per_worker": args.per_worker, "rounds": args.rounds,
-                                               "dataset": args.dataset, "core_speed": speed, **out}, indent=2) + "\n")
+                                               "dataset": args.dataset, "core_speed": speed,
+                                               "memory_speed": memory, **out}, indent=2) + "\n")
 
 
 if __name__ == "__main__":

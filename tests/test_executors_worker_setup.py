@@ -38,6 +38,7 @@ def test_workers_start_no_math_threads_by_default_and_give_the_records_of_the_li
     # the library default: numpy's OpenBLAS (loaded before the worker began) told to use every core
     assert all(s.setup is not None and any("openblas" in lib for lib in s.setup.libraries) for s in default_starts)
     assert max(s.threads for s in single_starts) < min(s.threads for s in default_starts)
+    assert [s.math_threads for s in single_starts] == [1, 1] and [s.math_threads for s in default_starts] == [CORES] * 2
     assert sorted(s.setup.core for s in pinned_starts if s.setup is not None) == sorted(os.sched_getaffinity(0))[:2]
     assert all(s.setup is not None and s.setup.malloc for s in pinned_starts)
     assert single.records == default.records == pinned.records and single.report == default.report == pinned.report
@@ -59,9 +60,39 @@ def test_the_fork_servers_variables_are_set_only_where_the_user_set_none(monkeyp
     env = {k: v for k, v in os.environ.items() if k not in MATH_THREAD_VARIABLES}
     monkeypatch.setattr(os, "environ", env)
     monkeypatch.setattr(worker_setup, "_SET_HERE", [])
-    assert worker_setup.single_threaded_env() == MATH_THREAD_VARIABLES
-    assert all(os.environ[v] == "1" for v in MATH_THREAD_VARIABLES)
     told: list[int | None] = []
     monkeypatch.setattr(worker_setup, "limit_math_threads", lambda n: told.append(n) or ())
+    assert worker_setup.single_threaded_env() == MATH_THREAD_VARIABLES and told == [1]
     assert not worker_setup.apply(WorkerSetup(), 0).user_kept  # its own setting is not the user's
-    assert told == [1]
+    assert told == [1, 1]
+
+
+def test_limit_math_threads_sets_the_variables_for_libraries_loaded_later(monkeypatch):
+    monkeypatch.setattr(os, "environ", {k: v for k, v in os.environ.items() if k not in MATH_THREAD_VARIABLES})
+    monkeypatch.setattr(worker_setup, "_loaded_libraries", lambda: [])  # leave this process's libraries alone
+    assert worker_setup.limit_math_threads(1) == ()
+    assert all(os.environ[v] == "1" for v in MATH_THREAD_VARIABLES)
+
+
+@pytest.mark.skipif(CORES < 2 or any(v in os.environ for v in MATH_THREAD_VARIABLES),
+                    reason="needs 2 cores and no user setting")
+@pytest.mark.parametrize("limit", [False, True])
+def test_a_fork_server_that_loaded_numpy_first_still_forks_single_threaded_workers(limit):
+    """numpy imported before the fork server's first module (a sitecustomize): its OpenBLAS has a
+    thread per core; told in the server, the processes forked from it split no call over threads."""
+    import subprocess
+    import sys
+
+    code = ("import os, numpy as np\n"
+            "from robocfg.executors.worker_setup import single_threaded_env\n"
+            f"if {limit}: single_threaded_env()\n"
+            "r, w = os.pipe()\n"
+            "if os.fork() == 0:\n"
+            "    a = np.ones((400, 400)); a @ a\n"
+            "    os.write(w, str(len(os.listdir('/proc/self/task'))).encode()); os._exit(0)\n"
+            "os.wait(); print(os.read(r, 16).decode())\n")
+    env = {k: v for k, v in os.environ.items() if k not in MATH_THREAD_VARIABLES}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr
+    threads = int(out.stdout.strip())
+    assert threads == 1 if limit else threads > 1

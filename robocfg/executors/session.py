@@ -149,7 +149,8 @@ class WorkerStart:
     (``created``), it began opening the recipe (``opening``: the interpreter, its imports and the
     recipe's unpickling done) and its session was open (``ready``: world, model and controllers
     built); ``niceness``: its scheduling niceness (a higher one yields the CPU to other processes);
-    ``threads``: the process's threads then (0: unknown); ``setup``: what a pool worker did to its
+    ``threads``: the process's threads then (0: unknown); ``math_threads``: the most threads a math
+    library loaded in it may use (0: none found; :func:`robocfg.executors.worker_setup.math_threads`); ``setup``: what a pool worker did to its
     process first (:mod:`robocfg.executors.worker_setup`; None: nothing, as in a Ray actor)."""
 
     pid: int
@@ -159,6 +160,7 @@ class WorkerStart:
     niceness: int = 0
     threads: int = 0
     setup: SetupDone | None = None
+    math_threads: int = 0
 
 
 def worker_start(opening: float, setup: SetupDone | None = None) -> WorkerStart:
@@ -167,8 +169,10 @@ def worker_start(opening: float, setup: SetupDone | None = None) -> WorkerStart:
     import time
 
     from robocfg.executors.usage import thread_count
+    from robocfg.executors.worker_setup import math_threads
 
-    return WorkerStart(os.getpid(), _created(), opening, time.time(), os.nice(0), thread_count(), setup)
+    return WorkerStart(os.getpid(), _created(), opening, time.time(), os.nice(0), thread_count(), setup,
+                       math_threads())
 
 
 def _created() -> float:

@@ -9,7 +9,9 @@ cores, burn CPU nobody asked for: on the lent 16-core machine a pool worker's fi
 which OpenBLAS honours). So the pool's fork server, before it imports numpy
 (:mod:`robocfg.executors.boot`), sets ``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS`` and
 ``MKL_NUM_THREADS`` to 1 — unless the user set any of them: then they keep what they set — and
-neither it nor its workers start math threads. A worker whose :class:`WorkerSetup` asks for
+neither it nor its workers start math threads (a library loaded before that — a
+``sitecustomize`` that imports numpy, as on the lent machine — is told there through its setter,
+so the workers forked from the server inherit a count of 1 and never start its threads). A worker whose :class:`WorkerSetup` asks for
 another count (``math_threads=None``: the libraries' default, a thread per core: the old
 behaviour, which a benchmark runs beside the new) sets the variables for libraries it loads later
 and tells the ones already loaded through their own ``*_set_num_threads`` (found among the
@@ -29,11 +31,11 @@ from __future__ import annotations
 
 import ctypes
 import os
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 MATH_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-# run-time setters of the libraries' thread counts (numpy's and scipy's wheels rename OpenBLAS's)
-# (setter, getter) of each library's thread count
+# run-time (setter, getter) of each library's thread count (numpy's and scipy's wheels rename OpenBLAS's)
 _SETTERS = (("openblas_set_num_threads", "openblas_get_num_threads"),
             ("openblas_set_num_threads64_", "openblas_get_num_threads64_"),
             ("scipy_openblas_set_num_threads", "scipy_openblas_get_num_threads"),
@@ -73,11 +75,12 @@ class SetupDone:
 
 def single_threaded_env() -> tuple[str, ...]:
     """Set the math libraries' thread variables to 1 in this process's environment unless the user
-    set any of them (a pool's fork server, before numpy is imported); returns those it set."""
+    set any of them (a pool's fork server, before numpy is imported); returns those it set. A
+    library loaded already (a ``sitecustomize`` that imports numpy) is told here too, so the
+    processes forked from this one inherit its count of 1 and never start its threads."""
     if not _SET_HERE and not any(v in os.environ for v in MATH_THREAD_VARIABLES):
-        for var in MATH_THREAD_VARIABLES:
-            os.environ[var] = "1"
         _SET_HERE.extend(MATH_THREAD_VARIABLES)
+        limit_math_threads(1)
     return tuple(_SET_HERE)
 
 
@@ -107,6 +110,22 @@ def limit_math_threads(n: int | None) -> tuple[str, ...]:
         for var in MATH_THREAD_VARIABLES:
             os.environ[var] = str(n)
     told: list[str] = []
+    for label, set_count, get_count in _math_libraries():
+        if get_count() != n:
+            set_count(n)
+            told.append(label)
+    return tuple(told)
+
+
+def math_threads() -> int:
+    """The most threads any math library loaded in this process may use now (0: none loaded or
+    none found): 1 in a pool worker unless set otherwise."""
+    return max((get_count() for _, _, get_count in _math_libraries()), default=0)
+
+
+def _math_libraries() -> Iterator[tuple[str, Callable[[int], None], Callable[[], int]]]:
+    """``(file name:setter, setter, getter)`` of each thread-count setter among the math libraries
+    loaded in this process, each once (a library that links another exposes its symbols too)."""
     seen: set[int] = set()
     for path in _loaded_libraries():
         try:
@@ -118,16 +137,12 @@ def limit_math_threads(n: int | None) -> tuple[str, ...]:
             if fn is None or get is None:
                 continue
             address = ctypes.cast(fn, ctypes.c_void_p).value or 0
-            if address in seen:  # found again through a library that links this one
+            if address in seen:
                 continue
             seen.add(address)
-            get.argtypes, get.restype = [], ctypes.c_int
-            if get() == n:
-                continue
             fn.argtypes, fn.restype = [ctypes.c_int], None
-            fn(n)
-            told.append(f"{os.path.basename(path)}:{setter}")
-    return tuple(told)
+            get.argtypes, get.restype = [], ctypes.c_int
+            yield f"{os.path.basename(path)}:{setter}", fn, get
 
 
 def _loaded_libraries() -> list[str]:
