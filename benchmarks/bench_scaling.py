@@ -291,9 +291,10 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
                   statistics.median(firsts.values()), [s.niceness for s in pool.starts],
                   TimeLine.of(out.done, called, returned, len(pool.starts))
                   if all(hasattr(b, "wall") for b in out.done) else None,  # older robocfg: no stamps
-                  statistics.median(first_threads.values()), [getattr(r, "usage", None) for r in runs],
-                  [getattr(s, "threads", 0) for s in pool.starts], steal, busy,
-                  [getattr(s, "math_threads", 0) for s in pool.starts])
+                  first_thread_cpu=statistics.median(first_threads.values()),
+                  usage=[getattr(r, "usage", None) for r in runs],
+                  threads=[getattr(s, "threads", 0) for s in pool.starts],
+                  math_threads=[getattr(s, "math_threads", 0) for s in pool.starts], steal_pct=steal, busy_pct=busy)
 
 
 def _settle(tree: TreeCpu, limit: float = 30.0) -> float:

@@ -34,3 +34,12 @@ def test_obstacle_modes_runs_one_episode_per_mode():
     assert p.returncode in (0, 1) and "Traceback" not in p.stderr, p.stderr[-3000:]
     rows = [line for line in p.stdout.splitlines() if line.startswith(("planned  ", "trajectory_no_wall  "))]
     assert len(rows) == 2 and all(" 1/1 " in r for r in rows), p.stdout
+
+
+def test_scaling_runs_one_episode_per_pool_variant():
+    p = _run(["benchmarks/bench_scaling.py", "--workers", "1", "--per-worker", "1", "--rounds", "1",
+              "--no-in-process", "--pool-variants", "single,default"], timeout=600)
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr[-3000:]
+    rows = [line.split() for line in p.stdout.splitlines() if line.startswith(("pool ", "pool-default "))]
+    usage = [r for r in rows if len(r) == 15 and "/" in r[10]]  # the per-episode usage table's rows
+    assert len(usage) == 2 and [r[12] for r in usage] == ["1", str(len(os.sched_getaffinity(0)))], p.stdout
