@@ -3,8 +3,8 @@
 *Math threads.* numpy's and scipy's OpenBLAS (MKL, an OpenMP runtime alike) start a thread per
 core in every process that loads them, and after a call they split, those threads spin waiting
 for the next one before they sleep. A worker is one core's worth of work by design — the pool
-runs one per core — so those threads only take cores from the other workers (or, with idle
-cores, burn CPU nobody asked for: on the lent 16-core machine a pool worker's first episode cost
+runs one per core — so those threads can only take cores from the other workers or, with idle
+cores, burn CPU nobody asked for (on the lent 16-core machine a 1-worker pool's first episode cost
 680–870 ms of process CPU against 121–237 ms in a Ray actor, whose Ray sets ``OMP_NUM_THREADS``,
 which OpenBLAS honours). So the pool's fork server, before it imports numpy
 (:mod:`robocfg.executors.boot`), sets ``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS`` and
