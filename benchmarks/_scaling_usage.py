@@ -18,6 +18,9 @@ builds what is built lazily, counted too):
 * ``proc ms`` — the worker process's CPU (every thread); ``main ms`` — the thread that ran the
   episode (``time.thread_time``); ``other`` — proc − main per episode (math-library or executor
   threads);
+* ``wall ms`` — the episode's wall time; ``phys ms`` — its wall time inside ``stepSimulation``
+  (with *had core* near 100 % these are CPU times too: whether a rise is the engine's or the
+  Python around it);
 * ``user ms`` / ``sys ms`` — the process's user and system CPU (``getrusage``);
 * ``minflt`` — minor page faults (a page first touched: mapped memory, zeroed by the kernel);
   ``vcsw`` / ``ivcsw`` — voluntary (waited: I/O, a lock, a sleep) and involuntary (preempted:
@@ -93,7 +96,8 @@ def usage_table(samples: list, kinds: list[str], counts: list[int]) -> list[dict
     """Print what an episode cost its process (see the module docstring) for each executor and
     worker count; return the rows as JSON-ready data."""
     print("\nWhat an episode cost its worker process (medians over episodes; steal, busy: medians over the rounds):")
-    print(f"{'executor':<13}{'w':>3}{'proc ms':>8}{'main ms':>8}{'other':>6}{'user ms':>8}{'sys ms':>7}{'minflt':>7}"
+    print(f"{'executor':<13}{'w':>3}{'proc ms':>8}{'main ms':>8}{'other':>6}{'wall ms':>8}{'phys ms':>8}"
+          f"{'user ms':>8}{'sys ms':>7}{'minflt':>7}"
           f"{'vcsw':>6}{'ivcsw':>6}{'1st proc/main':>14}{'threads':>8}{'math':>5}{'steal %':>8}{'busy %':>7}")
     rows = []
     for kind in kinds:
@@ -107,6 +111,8 @@ def usage_table(samples: list, kinds: list[str], counts: list[int]) -> list[dict
             other = [p - m for s in runs for p, m in zip(s.episode_cpu, s.episode_thread_cpu, strict=True)]
             row = {"executor": kind, "workers": w, "proc_ms": 1e3 * _med(proc), "main_ms": 1e3 * _med(main),
                    "other_ms": 1e3 * _med(other),
+                   "wall_ms": 1e3 * _med([c for s in runs for c in s.episode_wall]),
+                   "physics_ms": 1e3 * _med([c for s in runs for c in s.episode_physics]),
                    "user_ms": 1e3 * _med([u.user for u in usage]), "sys_ms": 1e3 * _med([u.system for u in usage]),
                    "minflt": _med([u.minflt for u in usage]), "majflt": _med([u.majflt for u in usage]),
                    "nvcsw": _med([u.nvcsw for u in usage]), "nivcsw": _med([u.nivcsw for u in usage]),
@@ -117,10 +123,12 @@ def usage_table(samples: list, kinds: list[str], counts: list[int]) -> list[dict
                    "steal_pct": [s.steal_pct for s in runs], "busy_pct": [s.busy_pct for s in runs]}
             rows.append(row)
             print(f"{kind:<13}{w:>3}{row['proc_ms']:>8.1f}{row['main_ms']:>8.1f}{row['other_ms']:>6.1f}"
+                  f"{row['wall_ms']:>8.1f}{row['physics_ms']:>8.1f}"
                   f"{row['user_ms']:>8.1f}{row['sys_ms']:>7.1f}{row['minflt']:>7.0f}{row['nvcsw']:>6.0f}{row['nivcsw']:>6.0f}"
                   f"{row['first_proc_ms']:>8.0f}/{row['first_main_ms']:<5.0f}{row['threads']:>8.0f}{row['math_threads']:>5.0f}"
                   f"{_med(row['steal_pct']):>8.2f}{_med(row['busy_pct']):>7.1f}")
-    print("(proc: the worker process's CPU; main: the episode's thread; other: proc − main; user/sys: the process's"
+    print("(proc: the worker process's CPU; main: the episode's thread; other: proc − main; wall: the episode's wall"
+          " time; phys: its wall time inside stepSimulation; user/sys: the process's"
           " user and system CPU; minflt: minor page faults; vcsw/ivcsw: voluntary/involuntary context switches;"
           " 1st: each worker's first episode; threads: the worker's threads once its world was built; math: its math"
           " libraries' thread count then;"

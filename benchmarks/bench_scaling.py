@@ -56,7 +56,8 @@ what each column means.
 *Core speed* (printed first): a fixed pure-Python loop's CPU time alone ÷ with w copies at once
 — what the machine's cores give when w of them are busy (turbo limits, shared caches), the part of
 the *cpu* factor below that no executor can change; *memory speed*: the same for sums over a
-32 MiB array (memory bandwidth per core with w busy).
+32 MiB array (memory bandwidth per core with w busy); *physics speed*: the same for 1000 bare
+physics steps of the task's world at rest (the engine alone, no robocfg code around it).
 
 Before each run the benchmark waits (up to 10 s, printed) until the processes under it use under
 half a core: the previous run's workers leaving and Ray starting idle workers to replace killed
@@ -74,6 +75,7 @@ pool with its (from the median starts and steady rates). The first row (unless
 from __future__ import annotations
 
 import argparse
+import functools
 import itertools
 import json
 import math
@@ -116,6 +118,8 @@ class Sample:
     usage: list = field(default_factory=list)  # per episode: robocfg.executors.usage.Usage (None: not taken)
     threads: list[int] = field(default_factory=list)  # each worker's threads once its world was built
     math_threads: list[int] = field(default_factory=list)  # each worker's math-library thread count then
+    episode_wall: list[float] = field(default_factory=list)  # per episode, wall time (s)
+    episode_physics: list[float] = field(default_factory=list)  # per episode, wall time inside stepSimulation (s)
     steal_pct: float = float("nan")  # the machine's steal time over the run, % of all CPUs' time
     busy_pct: float = float("nan")  # the machine's non-idle time over the run, % of all CPUs' time
 
@@ -294,7 +298,8 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
                   first_thread_cpu=statistics.median(first_threads.values()),
                   usage=[getattr(r, "usage", None) for r in runs],
                   threads=[getattr(s, "threads", 0) for s in pool.starts],
-                  math_threads=[getattr(s, "math_threads", 0) for s in pool.starts], steal_pct=steal, busy_pct=busy)
+                  math_threads=[getattr(s, "math_threads", 0) for s in pool.starts], steal_pct=steal, busy_pct=busy,
+                  episode_wall=[r.wall for r in runs], episode_physics=[r.physics for r in runs])
 
 
 def _settle(tree: TreeCpu, limit: float = 30.0) -> float:
@@ -332,12 +337,32 @@ def _stream(n: int) -> float:
     return time.process_time() - t
 
 
+_WORLD: list = []  # the physics kernel's world, built once per process
+
+
+def _physics(task_path: str, n: int) -> float:
+    """CPU time (s) of ``n`` bare ``World.step()`` calls on the task's world (robot at home, the
+    object on the table), built on this process's first call: the physics engine alone."""
+    if not _WORLD:
+        from robocfg.checks import load_task
+        from robocfg.sim.world import World
+
+        task = load_task(task_path)
+        world = World(task)
+        world.add_body(task.config.pick_place.object)
+        _WORLD.append(world)
+    t = time.process_time()
+    _WORLD[0].step(n)
+    return time.process_time() - t
+
+
 def core_speed(counts: list[int], n: int = 3_000_000, kernel=_spin) -> dict[int, float]:
     """For each worker count w: the CPU time of a fixed kernel alone ÷ its median CPU time with w
     copies running at once in w processes (1.0: a core is as fast with w busy; < 1: cores slow
     down when many are busy — turbo limits, shared caches, hyper-threads, memory bandwidth — which
     no executor changes). ``kernel``: a pure-Python loop (:func:`_spin`, ``n`` iterations: the
-    core itself) or sums over a large array (:func:`_stream`, ``n`` passes: memory bandwidth).
+    core itself), sums over a large array (:func:`_stream`, ``n`` passes: memory bandwidth) or
+    bare physics steps (:func:`_physics`: the engine with no robocfg code around it).
     Processes from the same fork server the pool uses."""
     import multiprocessing as mp
 
@@ -639,10 +664,13 @@ def main() -> None:
           f"(first pool of this process, fork server start included: {first:.2f} s)")
     speed = core_speed(counts)
     memory = core_speed(counts, 40, _stream)
+    physics = core_speed(counts, 1000, functools.partial(_physics, str(task.path)))
     print("core speed with w processes busy (a fixed pure-Python loop's CPU time alone ÷ with w at once): "
           + ", ".join(f"w={w} {f:.2f}" for w, f in speed.items()))
     print("memory speed with w processes busy (sums over a 32 MiB array, CPU time alone ÷ with w at once): "
           + ", ".join(f"w={w} {f:.2f}" for w, f in memory.items()))
+    print("physics speed with w processes busy (1000 bare steps of the task's world at rest, CPU time alone ÷ with w at once): "
+          + ", ".join(f"w={w} {f:.2f}" for w, f in physics.items()))
     tree = TreeCpu()
     samples = [] if args.no_in_process else [in_process(task, args.per_worker, ds())]
     kinds = [*pool_kinds(args.pool_variants), *(["ray"] if args.ray else []), *(["ray-kept"] if args.ray_kept else [])]
@@ -684,7 +712,7 @@ def main() -> None:
     if args.json:
         Path(args.json).write_text(json.dumps({"cores": cores, "per_worker": args.per_worker, "rounds": args.rounds,
                                                "dataset": args.dataset, "core_speed": speed,
-                                               "memory_speed": memory, **out}, indent=2) + "\n")
+                                               "memory_speed": memory, "physics_speed": physics, **out}, indent=2) + "\n")
 
 
 if __name__ == "__main__":

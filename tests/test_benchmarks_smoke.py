@@ -41,5 +41,6 @@ def test_scaling_runs_one_episode_per_pool_variant():
               "--no-in-process", "--pool-variants", "single,default"], timeout=600)
     assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr[-3000:]
     rows = [line.split() for line in p.stdout.splitlines() if line.startswith(("pool ", "pool-default "))]
-    usage = [r for r in rows if len(r) == 15 and "/" in r[10]]  # the per-episode usage table's rows
-    assert len(usage) == 2 and [r[12] for r in usage] == ["1", str(len(os.sched_getaffinity(0)))], p.stdout
+    usage = [r for r in rows if len(r) == 17 and "/" in r[12]]  # the per-episode usage table's rows
+    assert len(usage) == 2 and [r[14] for r in usage] == ["1", str(len(os.sched_getaffinity(0)))], p.stdout
+    assert "physics speed with w processes busy" in p.stdout
