@@ -96,3 +96,25 @@ def test_a_fork_server_that_loaded_numpy_first_still_forks_single_threaded_worke
     assert out.returncode == 0, out.stderr
     threads = int(out.stdout.strip())
     assert threads == 1 if limit else threads > 1
+
+
+@pytest.mark.skipif(CORES < 2 or any(v in os.environ for v in MATH_THREAD_VARIABLES),
+                    reason="needs 2 cores and no user setting")
+def test_a_ray_actors_libraries_loaded_before_ray_set_omp_follow_it():
+    """A Ray actor whose numpy was loaded before Ray set OMP_NUM_THREADS (a sitecustomize): its
+    OpenBLAS keeps a thread per core until told; a user's OPENBLAS_NUM_THREADS is left alone."""
+    import subprocess
+    import sys
+
+    code = ("import os, numpy as np\n"
+            "from robocfg.executors.worker_setup import follow_omp_threads, math_threads\n"
+            "before = math_threads(); os.environ['OMP_NUM_THREADS'] = '1'\n"
+            "told = follow_omp_threads(); print(before, math_threads(), len(told))\n")
+    env = {k: v for k, v in os.environ.items() if k not in MATH_THREAD_VARIABLES}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == [str(CORES), "1", "1"]
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env={**env, "OPENBLAS_NUM_THREADS": "2"}, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["2", "2", "0"]

@@ -17,7 +17,9 @@ behaviour, which a benchmark runs beside the new) sets the variables for librari
 and tells the ones already loaded through their own ``*_set_num_threads`` (found among the
 process's loaded shared objects, as threadpoolctl finds them; Linux ``/proc``) — called only
 where the count differs, since OpenBLAS starts its thread pool on that call. The numbers a
-worker computes are the same either way: one thread runs the same kernels.
+worker computes are the same either way: one thread runs the same kernels. A Ray actor gets
+``OMP_NUM_THREADS`` from Ray; :func:`follow_omp_threads` makes libraries it loaded before that
+follow it.
 
 *Pinning* (``pin=True``, off by default: measure it first): worker i is bound to core
 ``i mod n`` of the cores the driver may use (``os.sched_setaffinity``).
@@ -115,6 +117,18 @@ def limit_math_threads(n: int | None) -> tuple[str, ...]:
             set_count(n)
             told.append(label)
     return tuple(told)
+
+
+def follow_omp_threads() -> tuple[str, ...]:
+    """In a Ray actor: make the math libraries already loaded follow ``OMP_NUM_THREADS``, which Ray
+    sets to the actor's CPUs unless it is set (a library loaded before Ray set it — a
+    ``sitecustomize`` that imports numpy — would keep a thread per core); nothing when
+    ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS`` is set or ``OMP_NUM_THREADS`` is not a count.
+    Returns ``file name:setter`` of the libraries told."""
+    omp = os.environ.get("OMP_NUM_THREADS", "")
+    if "OPENBLAS_NUM_THREADS" in os.environ or "MKL_NUM_THREADS" in os.environ or not omp.isdigit() or int(omp) < 1:
+        return ()
+    return limit_math_threads(int(omp))
 
 
 def math_threads() -> int:
