@@ -91,7 +91,10 @@ def main() -> None:
     """Console-script entry point."""
     from robocfg.cli.common import debug_enabled, set_debug
     from robocfg.cli.errors import describe
+    from robocfg.cli.process import single_math_thread, skip_final_collection
 
+    single_math_thread()  # before numpy loads (robocfg.cli.process)
+    skip_final_collection()  # before any command registers its own atexit handlers
     set_debug("--debug" in sys.argv[1:])
     try:
         rv = app(standalone_mode=False)
