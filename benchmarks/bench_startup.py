@@ -17,7 +17,11 @@ warm-up run (file cache). Rows:
   (``robocfg.load_task`` → ``open_session`` → ``session.run(0)`` → ``session.run(1)``), timed from
   just before the spawn: *imports* (robocfg.engine and the task loader imported), *task* (loaded
   and checked), *world* (the world built: the **fixed start** a process pays before its first
-  episode), *episode 0* done, and *episode 1* alone (what each further episode costs).
+  episode), *episode 0* done, and *episode 1* alone (what each further episode costs). The child
+  runs with one math-library thread as those workers do (``OPENBLAS_NUM_THREADS``,
+  ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS`` = 1, unless set in this environment: a pool's fork
+  server sets them, Ray sets ``OMP_NUM_THREADS``); ``--math-threads default`` leaves the
+  libraries their default (a thread per core each for numpy's and scipy's OpenBLAS).
 
 For each row: min / median / max wall time and the median CPU time of the child (user + sys:
 what the wall time would be on an idle core). The machine's 1-minute load average is printed:
@@ -86,10 +90,10 @@ def _set_root(root: Path) -> None:
     ROOT = root
 
 
-def _timed(argv: list[str], cwd: Path | None = None) -> tuple[float, float, str]:
+def _timed(argv: list[str], cwd: Path | None = None, env: dict[str, str] | None = None) -> tuple[float, float, str]:
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    out = subprocess.run(argv, cwd=cwd or ROOT, capture_output=True, text=True, check=True)
+    out = subprocess.run(argv, cwd=cwd or ROOT, env=env, capture_output=True, text=True, check=True)
     wall = time.perf_counter() - t0
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime, out.stdout
@@ -104,18 +108,29 @@ def _row(label: str, wall: list[float], cpu: list[float], goal: float | None) ->
             "cpu_median_s": statistics.median(cpu), "goal_s": goal}
 
 
-def _first_episode(runs: int, roots: list[Path]) -> dict[Path, tuple[dict, dict]]:
+MATH_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _worker_env(math_threads: str) -> dict[str, str] | None:
+    """The first-episode child's environment: a pool worker's (one math thread unless the user set
+    a count: robocfg.executors.worker_setup.single_threaded_env) or, ``default``, this one's."""
+    if math_threads == "default" or any(v in os.environ for v in MATH_THREAD_VARIABLES):
+        return None
+    return dict(os.environ, **dict.fromkeys(MATH_THREAD_VARIABLES, "1"))
+
+
+def _first_episode(runs: int, roots: list[Path], env: dict[str, str] | None = None) -> dict[Path, tuple[dict, dict]]:
     """root → (wall, CPU) samples of each mark, the roots taking turns (order swapped each run)."""
     argv = [sys.executable, "-c", _FIRST]
     names = (*FIRST_MARKS, "episode 1 alone")
     out: dict[Path, tuple[dict, dict]] = {r: ({m: [] for m in names}, {m: [] for m in names}) for r in roots}
     for r in roots:
-        _timed(argv, r)  # warm-up
+        _timed(argv, r, env)  # warm-up
     for i in range(runs):
         for r in roots if i % 2 == 0 else roots[::-1]:
             wall, cpu = out[r]
             t0 = time.time()
-            _, _, stdout = _timed(argv, r)
+            _, _, stdout = _timed(argv, r, env)
             marks = json.loads(stdout.strip().splitlines()[-1])
             for m in FIRST_MARKS:
                 wall[m].append(marks[m][0] - t0)
@@ -156,6 +171,9 @@ def main() -> None:
     ap.add_argument("--root", type=Path, default=ROOT, help="the checkout to measure (default: this one)")
     ap.add_argument("--against", type=Path, default=None,
                     help="a second checkout measured in the same session, alternating with --root")
+    ap.add_argument("--math-threads", choices=("1", "default"), default="1",
+                    help="first-episode child: one math-library thread as a pool worker or Ray actor runs "
+                         "(default), or the libraries' default")
     args = ap.parse_args()
     _set_root(args.root.resolve())
     roots = [ROOT] + ([args.against.resolve()] if args.against is not None else [])
@@ -164,12 +182,13 @@ def main() -> None:
     if unknown:
         sys.exit(f"unknown rows: {', '.join(sorted(unknown))}")
     print(f"load average before: {os.getloadavg()[0]:.2f}   runs: {args.runs}   python: {sys.version.split()[0]}   "
-          f"root: {ROOT}" + (f"   against: {roots[1]}" if len(roots) == 2 else ""))
+          f"root: {ROOT}" + (f"   against: {roots[1]}" if len(roots) == 2 else "") +
+          f"   first-episode math threads: {args.math_threads}")
     print(f"{'row':<26}{'min s':>8}{'median s':>10}{'max s':>8}{'CPU s':>8}{'goal s':>8}  ok")
     rows = []
     for label in only:
         if label == "first-episode":
-            first = _first_episode(args.runs, roots)
+            first = _first_episode(args.runs, roots, _worker_env(args.math_threads))
             for m in (*FIRST_MARKS, "episode 1 alone"):
                 rows += _rows(f"first-episode: {m}", {r: (w[m], c[m]) for r, (w, c) in first.items()},
                               FIRST_GOAL.get(m))
