@@ -69,6 +69,9 @@ def test_validating_a_pick_place_of_a_box_imports_no_trimesh(tmp_path) -> None:
     names = _imported(tmp_path, ["validate", "robocfg/data/tasks/pick_place.yaml"])
     assert "robocfg.checks.grip_force" in names  # the checks that measure the object ran
     assert _heavy(names, [*NEVER, "pybullet"]) == []
+    # the reach check ran (validate asks the kind's command face), the episode code was not loaded
+    assert {"robocfg.motion.reach", "robocfg.runners.pick_place_command"} <= names
+    assert sorted({"robocfg.runners.pick_place", "robocfg.runners.pick_place_machine", *OTHER_KINDS} & names) == []
 
 
 def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp_path) -> None:

@@ -48,9 +48,10 @@ def validate(
             checked = load_robot(f, strict) if kind == "robot" else load_task(f, strict, overrides=changes)
             warnings = checked.warnings
             if isinstance(checked, CheckedTask):  # the kind's checks needing kinematics, not simulation (IK reach)
-                from robocfg.engine.registry import runner_for
+                # asked of the kind's command face: a built-in kind's episode code stays unloaded
+                from robocfg.engine.registry import command_for
 
-                static = runner_for(checked.config.task).static_problems(checked)
+                static = command_for(checked.config.task).static_problems(checked)
                 if any(p.severity == "error" for p in static):
                     raise ConfigError(static)
                 warnings = warnings + static

@@ -144,6 +144,15 @@ class TaskCommand:
     verb: ClassVar[str] = "succeeded"  # progress bar: "3 placed"
     episodic: ClassVar[bool] = False  # runs several seeded episodes (--episodes > 1)
 
+    @classmethod
+    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
+        """What ``validate`` reports for a task of this kind beyond its schema and cross-checks:
+        checks that need no simulation but do need the kinematics (IK reach of the task's poses),
+        with their severity. ``run`` makes the same checks in :meth:`TaskRunner.check`. Default:
+        none. A built-in kind defines them on its command face, so ``validate`` loads the
+        kinematics they need, not the episode code."""
+        return []
+
 
 class TaskRunner(TaskCommand, ABC):
     """Base of every task kind's runner; subclasses set the class attributes and ``run``."""
@@ -169,13 +178,6 @@ class TaskRunner(TaskCommand, ABC):
             raise ConfigError([Problem("--episodes", None, None, "",
                                        f"'run {self.kind}' runs one episode (it has nothing to randomise), "
                                        f"got {self.options.episodes}")])
-
-    @classmethod
-    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
-        """What ``validate`` reports for a task of this kind beyond its schema and cross-checks:
-        checks that need no simulation but do need the kinematics (IK reach of the task's poses),
-        with their severity. ``run`` makes the same checks in :meth:`check`. Default: none."""
-        return []
 
     @abstractmethod
     def run(self) -> RunOutput: ...

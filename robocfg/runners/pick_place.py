@@ -35,7 +35,6 @@ from robocfg.runners.pick_place_setup import (
 
 if TYPE_CHECKING:
     from robocfg.checks.task import CheckedTask
-    from robocfg.errors import Problem
 
 __all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episode_setup", "episode_setups",
            "run_pick_place"]
@@ -156,14 +155,6 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
 class PickPlaceRunner(PickPlaceCommand, EpisodicRunner):
     params = PickPlaceParams
     report = PickPlaceReport
-
-    @classmethod
-    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
-        """Poses out of the arm's reach (IK, tool down; nominal point or region corner), as warnings
-        naming the phase that would fail: ``run`` then fails those episodes without simulating."""
-        from robocfg.motion.placement import resolve_placement
-
-        return [r.problem(task) for r in resolve_placement(task, arm).reach]
 
     def open_session(self) -> PickPlaceSession:
         return PickPlaceSession(self.task, self.options)

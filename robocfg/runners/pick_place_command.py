@@ -4,9 +4,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from robocfg.engine.dataset import DatasetOptions
 from robocfg.engine.runner import TaskCommand
+
+if TYPE_CHECKING:
+    from robocfg.checks.task import CheckedTask
+    from robocfg.errors import Problem
 
 
 @dataclass(frozen=True)
@@ -28,3 +33,11 @@ class PickPlaceCommand(TaskCommand):
         "the task's cameras) and the kept ones are written as a LeRobot v3.0 or robomimic HDF5 dataset; "
         "`robocfg dataset replay` re-simulates an episode from those actions.")
     episodic = True
+
+    @classmethod
+    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
+        """Poses out of the arm's reach (IK, tool down; nominal point or region corner), as warnings
+        naming the phase that would fail: ``run`` then fails those episodes without simulating."""
+        from robocfg.motion.placement import resolve_placement
+
+        return [r.problem(task) for r in resolve_placement(task, arm).reach]

@@ -18,7 +18,6 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -38,9 +37,6 @@ from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch,
 from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
 from robocfg.runners.pick_place_many_spot import BinWalls
 from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
-
-if TYPE_CHECKING:
-    from robocfg.checks.task import CheckedTask
 
 BLOCK = "pick_place_many"
 
@@ -282,12 +278,6 @@ class PickPlaceManyRunner(PickPlaceManyCommand, EpisodicRunner):
         errors = [p for p in self._reach if p.severity == "error"]
         if errors:
             raise ConfigError(errors)
-
-    @classmethod
-    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
-        """Every object's and place spot's poses out of the arm's reach (:func:`reach_many`): a nominal
-        pose is an error, a region corner a warning."""
-        return reach_many(task, arm)
 
     def open_session(self) -> ManySession:
         session = ManySession(self.task, self.options)

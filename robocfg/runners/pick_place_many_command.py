@@ -4,9 +4,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from robocfg.engine.dataset import DatasetOptions
 from robocfg.engine.runner import TaskCommand
+
+if TYPE_CHECKING:
+    from robocfg.checks.task import CheckedTask
+    from robocfg.errors import Problem
 
 
 @dataclass(frozen=True)
@@ -27,3 +32,12 @@ class PickPlaceManyCommand(TaskCommand):
         "--dataset every episode is recorded as for pick-place, the environment state holding every object's pose "
         "in the task's order; `robocfg dataset replay` re-simulates an episode from its actions.")
     episodic = True
+
+    @classmethod
+    def static_problems(cls, task: CheckedTask, arm: str | None = None) -> list[Problem]:
+        """Every object's and place spot's poses out of the arm's reach
+        (:func:`robocfg.runners.pick_place_many.reach_many`): a nominal pose is an error, a region
+        corner a warning."""
+        from robocfg.runners.pick_place_many import reach_many
+
+        return reach_many(task, arm)
