@@ -36,7 +36,7 @@ a shared machine, not two modes. On the 2-core laptop the planned mode's whole r
 245 ms an episode from one round to the next, and the trajectory mode's 150 or 207 (a bare
 physics loop: 43–77 µs a step within a minute), while callgrind counts 1.105× the instructions
 for planned / trajectory without the wall (``bench_obstacle_instructions.py``: a count the load
-cannot move; code before 536a93d) and four passes of episodes alternating between the two modes
+cannot move; code before bb78e86) and four passes of episodes alternating between the two modes
 gave 1.12–1.13× CPU each while both modes' absolute CPU moved by 1.34× between passes.
 
 CPU time (``time.process_time``) is the figure to trust on a loaded machine; the issue's goal is
