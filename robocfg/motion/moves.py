@@ -88,7 +88,7 @@ class ArmMover:
     phase: str = "move"
     ik_budget: float = 1.0  # s of wall clock per IK query, for a model without bound_ik_by_iterations
     max_acceleration: float | None = None  # m/s²: the EE's peak acceleration in a timed move (a held load), None: free
-    _answers: dict[tuple[bytes, bytes], IKResult] = field(default_factory=dict, repr=False)  # see ik()
+    _answers: dict[tuple[bytes, bytes], IKResult] = field(default_factory=dict, init=False, repr=False)  # see ik()
 
     def ik(self, T: np.ndarray, seed: np.ndarray) -> IKResult:
         """IK of the EE pose ``T`` (4x4, world) from ``seed`` (rad or m), remembered for the mover's
