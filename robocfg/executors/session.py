@@ -150,8 +150,9 @@ class WorkerStart:
     recipe's unpickling done) and its session was open (``ready``: world, model and controllers
     built); ``niceness``: its scheduling niceness (a higher one yields the CPU to other processes);
     ``threads``: the process's threads then (0: unknown); ``math_threads``: the most threads a math
-    library loaded in it may use (0: none found; :func:`robocfg.executors.worker_setup.math_threads`); ``setup``: what a pool worker did to its
-    process first (:mod:`robocfg.executors.worker_setup`; None: nothing, as in a Ray actor)."""
+    library loaded in it may use (0: none found; :func:`robocfg.executors.worker_setup.math_threads`);
+    ``setup``: what a pool worker did to its process first (:mod:`robocfg.executors.worker_setup`;
+    None: nothing, as in a Ray actor)."""
 
     pid: int
     created: float

@@ -11,8 +11,8 @@ which OpenBLAS honours). So the pool's fork server, before it imports numpy
 ``MKL_NUM_THREADS`` to 1 — unless the user set any of them: then they keep what they set — and
 neither it nor its workers start math threads (a library loaded before that — a
 ``sitecustomize`` that imports numpy, as on the lent machine — is told there through its setter,
-so the workers forked from the server inherit a count of 1 and never start its threads). A worker whose :class:`WorkerSetup` asks for
-another count (``math_threads=None``: the libraries' default, a thread per core: the old
+so the workers forked from the server inherit a count of 1 and never start its threads). A
+worker whose :class:`WorkerSetup` asks for another count (``math_threads=None``: the libraries' default, a thread per core: the old
 behaviour, which a benchmark runs beside the new) sets the variables for libraries it loads later
 and tells the ones already loaded through their own ``*_set_num_threads`` (found among the
 process's loaded shared objects, as threadpoolctl finds them; Linux ``/proc``) — called only
