@@ -16,7 +16,7 @@ from robocfg.engine import RunOptions, open_session
 from robocfg.errors import PhaseFailed
 from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp, grasp_rotation
 from robocfg.motion.moves import ArmMover
-from robocfg.runners.pick_place_many_spot import WALL_MARGIN, turned
+from robocfg.runners.pick_place_many_spot import WALL_MARGIN, still_free, turned
 
 DUCK = {"name": "duck", "shape": "mesh", "mesh": "pybullet_data://duck_vhacd.urdf", "size": [0.6, 0.6, 0.6],
         "position": [0.55, -0.10, 0.117], "euler_deg": [0, 0, 0], "mass": 0.1, "color": [0.9, 0.8, 0.1, 1.0],
@@ -114,3 +114,72 @@ def test_a_turn_that_would_put_the_hand_on_a_placed_object_is_not_taken(duck_tas
             assert "mm clear of the objects" in exc.reason
         else:
             assert other.turn_deg != first.turn_deg and walls.hits(mover, other.T_place, 0.12, q0) is None
+
+
+def test_off_grid_spots_keep_the_gap_from_placed_objects_and_come_nearest_first():
+    """The lattice's points clear of the placed objects' footprints (plus the gap), the tried
+    spots left out, nearest the assigned spot first; a grid spot an off-grid footprint comes
+    within the gap of is reported overlapped."""
+    from robocfg.checks.clutter import off_grid_spots, overlapped
+
+    lattice = np.array([[x, y, 0.1] for x in (0.0, 0.02, 0.04, 0.06) for y in (0.0, 0.02)])
+    placed = [(np.array([0.06, 0.0]), 0.01)]
+    got = off_grid_spots(lattice, np.array([0.0, 0.0]), 0.01, 0.005, placed, [np.array([0.0, 0.0])])
+    assert [tuple(np.round(p, 3)) for p in got] == [(0.0, 0.02), (0.02, 0.0), (0.02, 0.02), (0.04, 0.02)]
+    assert all(np.linalg.norm(p - placed[0][0]) >= 0.025 for p in got)
+    spots = np.array([[0.0, 0.0], [0.03, 0.0], [0.05, 0.0]])
+    assert overlapped(np.array([0.0, 0.0]), 0.01, spots, 0.01, 0.01).tolist() == [True, False, False]
+    assert overlapped(np.array([0.02, 0.0]), 0.01, spots, 0.01, 0.01).tolist() == [True, True, False]
+    # the spot taken goes, and every one the footprint comes within the gap of; on the grid only the one taken
+    assert still_free(spots, [0, 1, 2], np.array([0.02, 0.0]), 0.01, 0.01, 0.01) == [2]
+    assert still_free(spots, [0, 1, 2], np.array([0.0, 0.0]), 0.01, 0.01, 0.01) == [1, 2]
+
+
+@pytest.fixture(scope="module")
+def tight_bin_task(tmp_path_factory):
+    """The duck alone into a bin 0.201 × 0.26 m (gap 5 mm): its 2 × 2 grid's spots are 4.7 cm from
+    the ±x walls and 7.6 cm from the ±y walls, where the open Panda hand fits at no turn; the
+    bin's middle, off the grid, has room."""
+    data = copy.deepcopy(yaml.safe_load(catalog.find("tasks", "clear_table").read_text()))
+    data["scene"]["fixtures"][0]["size"] = [0.201, 0.26, 0.06]
+    data["pick_place_many"]["objects"] = [DUCK]
+    data["pick_place_many"]["place"]["gap"] = 0.005
+    path = tmp_path_factory.mktemp("tight") / "duck_tight_bin.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return load_task(path)
+
+
+def test_every_grid_spot_refused_the_duck_is_placed_off_the_grid(tight_bin_task):
+    """Seed 0 episode 0: no grid spot clears the open hand at any turn, so an off-grid spot on
+    the duck's lattice is tried and taken; the duck rests there (its pose read from the world)
+    and the robot touches no fixture."""
+    lines: list[str] = []
+    with open_session(tight_bin_task, RunOptions(seed=0, log=lines.append)) as session:
+        grid, lattice = session.spot_xy.copy(), session.lattice[0].copy()
+        record = session.run(0)
+        final = session.world.body_pose("duck")[0]
+    assert len(grid) == 4
+    assert record.success, record.reason
+    assert record.robot_fixture_contacts == 0, record.contacts_by_kind
+    duck = record.objects[0]
+    target = np.array(duck.place_target)
+    assert np.min(np.linalg.norm(grid - target, axis=1)) > 0.01  # off the grid
+    assert np.min(np.linalg.norm(lattice - target, axis=1)) < 1e-5  # on the lattice
+    assert np.linalg.norm(final[:2] - target) < 0.01 and np.allclose(duck.final, final, atol=1e-6)
+    assert any("off the grid" in line for line in lines), lines
+
+
+def test_no_spot_anywhere_is_refused_naming_the_off_grid_spots_tried(tight_bin_task):
+    """With the hand 2 cm inside the bin's wall at its only grid spot and every off-grid spot
+    as tight (the same point), the refusal names how many off-grid spots were tried."""
+    with open_session(tight_bin_task, RunOptions(seed=0)) as session:
+        walls = session.walls
+        assert walls is not None
+        mover = ArmMover(session.world, session.handle, session.tools.model, session.tools.limits, phase="transport")
+        q0 = np.asarray(session.arm_cfg.home, float)
+        T, xy = _near_wall(session, 0.02)
+        with pytest.raises(PhaseFailed) as exc:
+            walls.choose(mover, T, xy, [xy], 0.12, q0, lambda: [xy.copy(), xy.copy()])
+        assert "; 2 off-grid spots tried too)" in exc.value.reason
+        choice = walls.choose(mover, T, xy, [xy], 0.12, q0, lambda: [xy.copy(), np.array([0.5, 0.27])])
+        assert np.allclose(choice.xy, [0.5, 0.27]) and walls.hits(mover, choice.T_place, 0.12, q0) is None

@@ -90,6 +90,49 @@ def place_spots(scene: Scene, place: PlaceInto, radius: float) -> PlaceSpots:
     return PlaceSpots(pts, T[:3, :3] @ front, None if ceiling is None else float(T[2, 3] + ceiling))
 
 
+# the off-grid lattice's pitch as a share of the grid's (2·radius + gap)
+OFF_GRID_PITCH = 0.25
+
+
+def bin_lattice(scene: Scene, place: PlaceInto, radius: float) -> np.ndarray:
+    """Centres (k, 3; m, world, on the bin's floor) of a finer lattice than :func:`place_spots`'
+    grid (pitch ``OFF_GRID_PITCH``·(2·radius + gap), centred, so the grid's spots are on it) where
+    an object of footprint ``radius`` keeps ``place.gap`` from the bin's walls; in grid order.
+    Empty for a shelf."""
+    from robocfg.geometry import pose_matrix
+
+    f = place_fixture(scene, place)
+    if not isinstance(f, BinFixture):
+        return np.zeros((0, 3))
+    x, y, _ = f.size
+    pitch = OFF_GRID_PITCH * (2 * radius + place.gap)
+    hx, hy = x / 2 - f.wall - place.gap - radius, y / 2 - f.wall - place.gap - radius
+    local = np.array([[a, b, f.floor_height(), 1.0] for a in _row(hx, pitch) for b in _row(hy, pitch)]).reshape(-1, 4)
+    return (pose_matrix(f) @ local.T).T[:, :3]
+
+
+def off_grid_spots(lattice: np.ndarray, near: np.ndarray, radius: float, gap: float,
+                   placed: list[tuple[np.ndarray, float]], tried: list[np.ndarray]) -> list[np.ndarray]:
+    """Points (x, y; m, world) of ``lattice`` (k, ≥2) where an object of footprint ``radius``
+    keeps ``gap`` from every ``placed`` object (its centre x, y and footprint radius, m) and that
+    are none of the ``tried`` spots; nearest to ``near`` first (ties in lattice order)."""
+    out = []
+    for p in lattice[:, :2]:
+        if any(float(np.linalg.norm(p - np.asarray(t, float)[:2])) < 1e-6 for t in tried):
+            continue
+        if all(float(np.linalg.norm(p - np.asarray(c, float)[:2])) >= radius + r + gap for c, r in placed):
+            out.append(p.copy())
+    order = np.argsort([float(np.linalg.norm(p - near[:2])) for p in out], kind="stable")
+    return [out[i] for i in order]
+
+
+def overlapped(xy: np.ndarray, radius: float, spots: np.ndarray, spot_radius: float, gap: float) -> np.ndarray:
+    """Which of ``spots`` (k, ≥2; m) an object of footprint ``radius`` at ``xy`` comes within
+    ``gap`` of, an object of footprint ``spot_radius`` standing on each (bool, k)."""
+    d = np.linalg.norm(np.asarray(spots, float)[:, :2] - np.asarray(xy, float)[:2], axis=1)
+    return np.asarray(d < radius + spot_radius + gap - 1e-9)
+
+
 def _row(half: float, pitch: float) -> np.ndarray:
     """Centres of a row of spots ``pitch`` apart within ±``half`` (m), centred on 0."""
     if half < 0:

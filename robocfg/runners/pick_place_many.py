@@ -6,10 +6,15 @@ Episode k draws every object's position and yaw within its own region from
 them one at a time in the listed order or, with ``order: reachability``, at each turn the object
 whose collision-free grasp needs the least joint travel. The i-th object placed goes to the i-th
 place spot (:func:`robocfg.checks.clutter.place_spots`: spaced so placed objects do not land on
-each other). Each object runs pick-place's phases (:mod:`.pick_place_many_machine`); the first
+each other; a bin spot where the open hand fits at no turn gives way to the next free one, and
+when none does, to a spot off the grid: :mod:`.pick_place_many_spot`). Each object runs pick-place's phases (:mod:`.pick_place_many_machine`); the first
 failure ends the episode and names the object and the phase. Before simulating: the scene checks
 of :mod:`robocfg.checks.clutter` (at load) and, here, IK reach of every object's spot (nominal and
 region corners) and of every place spot used.
+
+Over 300 lines: the session (its episode loop with the place-spot bookkeeping, the replay judge)
+and the static reach check share the spot helpers at the top; the spot geometry itself lives in
+:mod:`robocfg.checks.clutter` and :mod:`.pick_place_many_spot`.
 """
 
 from __future__ import annotations
@@ -35,7 +40,7 @@ from robocfg.motion.moves import MoveFailed, bound_ik_by_iterations
 from robocfg.runners.pick_place_many_command import PickPlaceManyCommand
 from robocfg.runners.pick_place_many_machine import ClutterFilter, ContactWatch, ObjectMachine, Spot
 from robocfg.runners.pick_place_many_report import ManyEpisode, ManyReport, ObjectRecord, summarise
-from robocfg.runners.pick_place_many_spot import BinWalls
+from robocfg.runners.pick_place_many_spot import BinWalls, still_free
 from robocfg.runners.pick_place_setup import EpisodeSetup, _Tools
 
 BLOCK = "pick_place_many"
@@ -105,11 +110,16 @@ class ManySession(EpisodeSession[ManyEpisode]):
         self.params: PickPlaceManyParams = self.task.config.pick_place_many  # type: ignore[union-attr]
         self.handle = self.world.robot.arm(self.arm_cfg.name)
         self.bodies = [as_body(o) for o in self.params.objects]
+        self.bodies_index = {b.name: i for i, b in enumerate(self.bodies)}
         self.shapes = [object_shape(b, self.task.path.parent) for b in self.bodies]
         # every spot of the target: the first ones in order, the rest spare (a spot where the open
         # hand cannot clear a bin's walls gives way to the next free one)
         self.spots = spots_for(self.task, self.params, spare=True)
         self.spot_xy = spot_points(self.task, self.params, spare=True)[:, :2]
+        from robocfg.checks.clutter import bin_lattice, footprint_radius
+
+        self.radii = [footprint_radius(o, self.task.path.parent) for o in self.params.objects]
+        self.lattice = [bin_lattice(self.task.config.scene, self.params.place, r)[:, :2] for r in self.radii]
         model = KinematicModel.from_robot(robot, arm=self.arm_cfg.name, base_pose=self.world.robot.base_pose())
         bound_ik_by_iterations(model)
         scale = self.params.speed_scale
@@ -184,6 +194,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
             name = self._next(machines, remaining)
             m = machines[name]
             m.spare_xy = [self.spot_xy[i] for i in free[1:]]
+            m.off_grid = self._off_grid(machines, name, order, free, len(remaining) - 1)
             current[:] = [m]
             order.append(name)
             remaining.remove(name)
@@ -192,7 +203,7 @@ class ManySession(EpisodeSession[ManyEpisode]):
             except MoveFailed as exc:
                 m.close_phase(False, exc.reason)
                 failure = (name, exc.phase, exc.reason)
-            free.remove(min(free, key=lambda i: float(np.linalg.norm(self.spot_xy[i] - m.setup.place_xy))))
+            free = self._still_free(free, self.bodies_index[name], m.setup.place_xy)
         records = [self._record(machines[b.name], b.name in order, starts[b.name], failure) for b in self.bodies]
         return ManyEpisode(
             index=k, seed=self.seed + k, success=failure is None, failed_phase=failure[1] if failure else None,
@@ -207,14 +218,22 @@ class ManySession(EpisodeSession[ManyEpisode]):
         machines = self._machines(k, None, None)
 
         def judge() -> tuple[bool, str]:
-            """Every object at rest on its own place spot (the nearest unused one, in the task's
-            order), upright: the run's final check of each object."""
+            """Every object at rest on its own place spot (the nearest unused grid spot, in the
+            task's order, or, farther than the tolerance from every free one, the nearest point of
+            its off-grid lattice: which off-grid spot the run took is not known here), upright:
+            the run's final check of each object."""
             free = list(range(len(self.spot_xy)))
             for name, m in machines.items():
                 xy = self.world.body_pose(m.obj)[0][:2]
-                j = min(free, key=lambda i: float(np.linalg.norm(self.spot_xy[i] - xy)))
-                free.remove(j)
-                m.assign(self.spot_xy[j], self.spots[j])
+                j = min(free, key=lambda i: float(np.linalg.norm(self.spot_xy[i] - xy)), default=None)
+                at = self.spot_xy[j] if j is not None else None
+                lattice = self.lattice[self.bodies_index[name]]
+                if (at is None or np.linalg.norm(at - xy) > self.params.success_tolerance) and len(lattice):
+                    at = lattice[int(np.argmin(np.linalg.norm(lattice - xy, axis=1)))]  # an off-grid spot
+                if at is None:
+                    return False, f"{name}: place: no place spot left for it"
+                free = self._still_free(free, self.bodies_index[name], at)
+                m.assign(at, self.spots[0 if j is None else j])
                 try:
                     m._check_placed()
                 except MoveFailed as exc:
@@ -222,6 +241,32 @@ class ManySession(EpisodeSession[ManyEpisode]):
             return True, f"{len(machines)} objects placed"
 
         return ReplayScene(self.world, self.handle, {n: m.obj for n, m in machines.items()}, judge)
+
+    def _still_free(self, free: list[int], i: int, xy: np.ndarray) -> list[int]:
+        """``free`` once object ``i`` went to ``xy`` (:func:`.pick_place_many_spot.still_free`)."""
+        return still_free(self.spot_xy, free, xy, self.radii[i], max(self.radii), self.params.place.gap)
+
+    def _off_grid(self, machines: dict[str, ObjectMachine], name: str, order: list[str], free: list[int],
+                  later: int) -> Callable[[], list[np.ndarray]] | None:
+        """The off-grid spots (x, y, m; nearest the assigned spot first) object ``name`` may take
+        when no grid spot clears the hand: on its lattice, its footprint ``gap`` from the objects
+        placed so far (``order``, where they lie now), and leaving ``later`` grid spots of ``free``
+        for the objects after it. None for a shelf."""
+        from robocfg.checks.clutter import off_grid_spots
+
+        i = self.bodies_index[name]
+        if self.walls is None or not len(self.lattice[i]):
+            return None
+        m = machines[name]
+
+        def spots() -> list[np.ndarray]:
+            placed = [(self.world.body_pose(machines[n].obj)[0][:2], self.radii[self.bodies_index[n]]) for n in order
+                      if n != name]
+            tried = [self.spot_xy[j] for j in free]
+            cands = off_grid_spots(self.lattice[i], m.setup.place_xy, self.radii[i], self.params.place.gap, placed, tried)
+            return [c for c in cands if len(self._still_free(free, i, c)) >= later]
+
+        return spots
 
     def _next(self, machines: dict[str, ObjectMachine], remaining: list[str]) -> str:
         """The next object: the first listed, or (reachability) the one whose collision-free grasp

@@ -148,6 +148,8 @@ class ObjectMachine(_StateMachine):
         self.rejected: list[str] = []  # what each candidate dropped for a collision hit (first pair)
         self.walls = walls  # a bin target's walls (None: no hand-clearance choice, e.g. a shelf)
         self.spare_xy: list[np.ndarray] = []  # free place spots (x, y, m) to fall back on, in order
+        # spots off the grid (x, y, m) to try when no grid spot clears the hand (asked only then)
+        self.off_grid: Callable[[], list[np.ndarray]] | None = None
         self.place_turn_deg = 0.0  # the hand's turn (deg) about the object's vertical at the place
 
     @property
@@ -264,14 +266,17 @@ class ObjectMachine(_StateMachine):
         self._check_placed()
 
     def _clear_of_walls(self, walls: BinWalls, T_place: np.ndarray, top: float) -> np.ndarray:
-        """The EE place pose at the assigned spot, or the first spare one (``spare_xy``), turned
+        """The EE place pose at the assigned spot, or the first spare one (``spare_xy``), or one off
+        the grid (``off_grid``), turned
         the least about the object's vertical so the open hand clears the bin's walls up to
         ``top`` m above it (:mod:`.pick_place_many_spot`); the spot taken becomes ``place_xy``."""
         spots = [self.setup.place_xy, *self.spare_xy]
         walls.see_objects(self.world, held=self.setup.body.name)
-        choice = walls.choose(self.mover, T_place, self.setup.place_xy, spots, top, self.arm.joint_positions())
+        choice = walls.choose(self.mover, T_place, self.setup.place_xy, spots, top, self.arm.joint_positions(),
+                              self.off_grid)
         if choice.turn_deg or not np.allclose(choice.xy, self.setup.place_xy):
-            self.log(f"  place: spot [{choice.xy[0]:.3f}, {choice.xy[1]:.3f}] m, hand turned {choice.turn_deg:+.0f}° "
+            off = "" if any(np.allclose(choice.xy, s) for s in spots) else " (off the grid: no grid spot fits)"
+            self.log(f"  place: spot [{choice.xy[0]:.3f}, {choice.xy[1]:.3f}] m{off}, hand turned {choice.turn_deg:+.0f}° "
                      f"to keep the open hand clear of {walls.fixture!r}'s walls")
         self.setup = dataclasses.replace(self.setup, place_xy=choice.xy)
         self.place_turn_deg = choice.turn_deg

@@ -12,7 +12,10 @@ straight line up to the highest pose the lower starts from or the retract ends a
 pinocchio + coal on the robot's own collision geometry (two
 :class:`~robocfg.planning.checker.CollisionChecker`: the walls; the objects, the held one parked). The turn nearest
 zero is taken (turning by 0 changes nothing); a spot where no turn fits gives way to the next free
-spot; when none fits anywhere the phase fails naming what the hand would touch.
+spot; when no grid spot fits, up to ``MAX_OFF_GRID`` spots off the grid (a finer lattice in the
+same bin, clear of the placed objects, nearest the assigned spot first:
+:func:`robocfg.checks.clutter.off_grid_spots`) are tried the same way; when none fits anywhere the
+phase fails naming what the hand would touch and how many off-grid spots were tried.
 
 Frames: world, 4×4, metres; turns in degrees about the world's z axis.
 """
@@ -20,7 +23,7 @@ Frames: world, 4×4, metres; turns in degrees about the world's z axis.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -40,6 +43,8 @@ if TYPE_CHECKING:
 WALL_MARGIN = 0.01  # m the open hand and the arm keep from a bin's walls (the planner's margin)
 # turns (deg) tried, nearest first; a parallel gripper turned by 180° is the same hand
 TURNS_DEG = (0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 60.0, -60.0, 75.0, -75.0, 90.0)
+# off-grid spots tried at most after the grid's (each: up to len(TURNS_DEG) IK solves + line checks)
+MAX_OFF_GRID = 16
 
 
 def turned(T: np.ndarray, centre_xy: np.ndarray, deg: float) -> np.ndarray:
@@ -52,6 +57,22 @@ def turned(T: np.ndarray, centre_xy: np.ndarray, deg: float) -> np.ndarray:
     out[:3, 3] = c + Rz @ (T[:3, 3] - c)
     out[2, 3] = T[2, 3]
     return out
+
+
+def still_free(spot_xy: np.ndarray, free: list[int], xy: np.ndarray, radius: float, spot_radius: float,
+               gap: float) -> list[int]:
+    """``free`` (indices of the grid's spots ``spot_xy``, k × 2, m) without the one nearest ``xy``
+    (x, y, m: where an object of footprint ``radius`` went) and every one its footprint there
+    comes within ``gap`` of, an object of footprint ``spot_radius`` on it: an off-grid spot can
+    cover grid spots, which are then no later object's to take. On the grid (``radius`` ≤
+    ``spot_radius``) only the spot taken goes."""
+    from robocfg.checks.clutter import overlapped
+
+    if not free:
+        return free
+    nearest = min(free, key=lambda j: float(np.linalg.norm(spot_xy[j] - xy)))
+    hit = overlapped(xy, radius, spot_xy[free], spot_radius, gap)
+    return [j for j, h in zip(free, hit, strict=True) if j != nearest and not h]
 
 
 @dataclass(frozen=True)
@@ -119,10 +140,27 @@ class BinWalls:
         return None
 
     def choose(self, mover: ArmMover, T_place: np.ndarray, obj_xy: np.ndarray, spots: list[np.ndarray],
-               top: float, q0: np.ndarray) -> PlaceChoice:
-        """The first of ``spots`` (x, y, m; in order) with the least turn that clears the walls.
+               top: float, q0: np.ndarray, off_grid: Callable[[], list[np.ndarray]] | None = None) -> PlaceChoice:
+        """The first of ``spots`` (x, y, m; in order) with the least turn that clears the walls;
+        failing all, the first of at most ``MAX_OFF_GRID`` of ``off_grid()`` (asked only then).
         ``T_place``: the EE place pose with the object's centre at ``obj_xy``, untuned."""
         misses: list[str] = []
+        choice = self._first_clear(mover, T_place, obj_xy, spots, top, q0, misses)
+        extra = list(off_grid()[:MAX_OFF_GRID]) if choice is None and off_grid is not None else []
+        if choice is None and extra:
+            choice = self._first_clear(mover, T_place, obj_xy, extra, top, q0, [])
+        if choice is not None:
+            return choice
+        objects = "" if self.objects is None else f" and {self.objects.margin * 1000:.0f} mm clear of the objects"
+        tried = "" if off_grid is None else f"; {len(extra)} off-grid spots tried too"
+        raise MoveFailed(mover.phase, f"no place spot in {self.fixture!r} keeps the open hand "
+                                      f"{WALL_MARGIN * 1000:.0f} mm clear of its walls{objects} at any turn "
+                                      f"(unturned: {'; '.join(misses)}{tried})")
+
+    def _first_clear(self, mover: ArmMover, T_place: np.ndarray, obj_xy: np.ndarray, spots: Sequence[np.ndarray],
+                     top: float, q0: np.ndarray, misses: list[str]) -> PlaceChoice | None:
+        """The first of ``spots`` with the least turn that clears (None: none); what each spot
+        touches unturned is added to ``misses``."""
         for xy in spots:
             shift = np.array([xy[0] - obj_xy[0], xy[1] - obj_xy[1], 0.0])
             T_at = T_place.copy()
@@ -134,7 +172,4 @@ class BinWalls:
                     return PlaceChoice(np.asarray(xy, float), deg, T)
                 if deg == 0.0:
                     misses.append(f"[{xy[0]:.3f}, {xy[1]:.3f}]: {why}")
-        objects = "" if self.objects is None else f" and {self.objects.margin * 1000:.0f} mm clear of the objects"
-        raise MoveFailed(mover.phase, f"no place spot in {self.fixture!r} keeps the open hand "
-                                      f"{WALL_MARGIN * 1000:.0f} mm clear of its walls{objects} at any turn "
-                                      f"(unturned: {'; '.join(misses)})")
+        return None
