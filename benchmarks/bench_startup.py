@@ -46,6 +46,8 @@ import sys
 import time
 from pathlib import Path
 
+from robocfg.executors.worker_setup import MATH_THREAD_VARIABLES
+
 ROOT = Path(__file__).resolve().parent.parent  # replaced by --root
 ROBOCFG = [sys.executable, "-m", "robocfg"]
 
@@ -106,9 +108,6 @@ def _row(label: str, wall: list[float], cpu: list[float], goal: float | None) ->
           f"{'' if goal is None else f'{goal:.2f}':>8}  {ok}")
     return {"row": label, "min_s": min(wall), "median_s": med, "max_s": max(wall),
             "cpu_median_s": statistics.median(cpu), "goal_s": goal}
-
-
-MATH_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 def _worker_env(math_threads: str) -> dict[str, str] | None:

@@ -11,8 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from robocfg.cli.process import MATH_THREAD_VARIABLES
-from robocfg.executors.worker_setup import MATH_THREAD_VARIABLES as WORKER_VARIABLES
+from robocfg.executors.worker_setup import MATH_THREAD_VARIABLES
 
 ROOT = Path(__file__).resolve().parents[1]
 VALIDATE = ["validate", "robocfg/data/tasks/pick_place.yaml"]  # loads numpy and scipy's LAPACK (reach IK)
@@ -55,10 +54,6 @@ def test_math_threads_chosen_by_the_user_are_kept() -> None:
 def test_a_program_importing_robocfg_keeps_its_math_threads_and_exit() -> None:
     blas, omp, _, frozen = _probe("import robocfg, numpy\nfrom robocfg.checks import load_task\n")
     assert (blas, omp, frozen) == ("None", "None", "False")
-
-
-def test_the_variables_are_the_pool_workers() -> None:
-    assert MATH_THREAD_VARIABLES == WORKER_VARIABLES
 
 
 def test_handlers_a_command_registers_run_before_the_freeze() -> None:

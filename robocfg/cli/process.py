@@ -5,8 +5,8 @@ core as they load, which spins ≈ 0.05 s of CPU (2-core laptop) waiting for wor
 robocfg's products are of 3..7-element vectors and matrices, which one thread computes. So the
 command sets ``OPENBLAS_NUM_THREADS``, ``OMP_NUM_THREADS`` and ``MKL_NUM_THREADS`` to 1 before it
 imports numpy, as a pool's fork server does for its workers
-(:func:`robocfg.executors.worker_setup.single_threaded_env`, not imported here: its ``ctypes``
-would cost every ``robocfg --help`` ≈ 5 ms) — unless the user set any of them, or numpy was loaded
+(:func:`robocfg.executors.worker_setup.single_threaded_env`, which also tells libraries loaded
+already; not called here: its ``ctypes`` would cost every ``robocfg --help`` ≈ 5 ms) — unless the user set any of them, or numpy was loaded
 before the command started.
 
 *Exit* (:func:`skip_final_collection`). At exit CPython runs atexit handlers, then a full collection of every object still alive (the
@@ -36,8 +36,8 @@ import gc
 import os
 import sys
 
-# robocfg.executors.worker_setup.MATH_THREAD_VARIABLES (a test checks they agree)
-MATH_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+from robocfg.executors.worker_setup import MATH_THREAD_VARIABLES
+
 _registered = False
 
 

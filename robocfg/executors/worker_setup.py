@@ -31,7 +31,6 @@ mapped, faulted in and unmapped on every call.
 
 from __future__ import annotations
 
-import ctypes
 import os
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -140,6 +139,8 @@ def math_threads() -> int:
 def _math_libraries() -> Iterator[tuple[str, Callable[[int], None], Callable[[], int]]]:
     """``(file name:setter, setter, getter)`` of each thread-count setter among the math libraries
     loaded in this process, each once (a library that links another exposes its symbols too)."""
+    import ctypes  # here, not at the top: the robocfg command imports this module for its constant
+
     seen: set[int] = set()
     for path in _loaded_libraries():
         try:
@@ -173,6 +174,8 @@ def _loaded_libraries() -> list[str]:
 def _keep_on_heap() -> bool:
     """glibc: a fixed mmap threshold (no dynamic raise, no per-call maps for temporaries below
     it) and a high trim threshold; False where there is no glibc ``mallopt``."""
+    import ctypes
+
     try:
         libc = ctypes.CDLL(None)
         mallopt = libc.mallopt
