@@ -71,7 +71,7 @@ def place_spots(scene: Scene, place: PlaceInto, radius: float) -> PlaceSpots:
     x, y, z = f.size
     pitch = 2 * radius + place.gap
     if isinstance(f, BinFixture):
-        hx, hy = x / 2 - f.wall - place.gap - radius, y / 2 - f.wall - place.gap - radius
+        hx, hy = _bin_reach(f, place, radius)
         xs, ys, h, ceiling = _row(hx, pitch), _row(hy, pitch), f.floor_height(), None
         front = np.zeros(3)
     else:
@@ -96,17 +96,17 @@ OFF_GRID_PITCH = 0.25
 
 def bin_lattice(scene: Scene, place: PlaceInto, radius: float) -> np.ndarray:
     """Centres (k, 3; m, world, on the bin's floor) of a finer lattice than :func:`place_spots`'
-    grid (pitch ``OFF_GRID_PITCH``·(2·radius + gap), centred, so the grid's spots are on it) where
-    an object of footprint ``radius`` keeps ``place.gap`` from the bin's walls; in grid order.
-    Empty for a shelf."""
+    grid (pitch ``OFF_GRID_PITCH``·(2·radius + gap), centred like the grid; a grid spot lies on it
+    only when the two rows have the same parity, and the spots tried already are skipped by
+    :func:`off_grid_spots` either way) where an object of footprint ``radius`` keeps ``place.gap``
+    from the bin's walls; in grid order. Empty for a shelf."""
     from robocfg.geometry import pose_matrix
 
     f = place_fixture(scene, place)
     if not isinstance(f, BinFixture):
         return np.zeros((0, 3))
-    x, y, _ = f.size
     pitch = OFF_GRID_PITCH * (2 * radius + place.gap)
-    hx, hy = x / 2 - f.wall - place.gap - radius, y / 2 - f.wall - place.gap - radius
+    hx, hy = _bin_reach(f, place, radius)
     local = np.array([[a, b, f.floor_height(), 1.0] for a in _row(hx, pitch) for b in _row(hy, pitch)]).reshape(-1, 4)
     return (pose_matrix(f) @ local.T).T[:, :3]
 
@@ -131,6 +131,13 @@ def overlapped(xy: np.ndarray, radius: float, spots: np.ndarray, spot_radius: fl
     ``gap`` of, an object of footprint ``spot_radius`` standing on each (bool, k)."""
     d = np.linalg.norm(np.asarray(spots, float)[:, :2] - np.asarray(xy, float)[:2], axis=1)
     return np.asarray(d < radius + spot_radius + gap - 1e-9)
+
+
+def _bin_reach(f: BinFixture, place: PlaceInto, radius: float) -> tuple[float, float]:
+    """How far (m, along the bin's x and y) from the bin's centre an object of footprint
+    ``radius`` may stand and keep ``place.gap`` from the inner faces of its walls."""
+    x, y, _ = f.size
+    return x / 2 - f.wall - place.gap - radius, y / 2 - f.wall - place.gap - radius
 
 
 def _row(half: float, pitch: float) -> np.ndarray:
