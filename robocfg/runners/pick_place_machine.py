@@ -268,12 +268,14 @@ class _StateMachine(GraspChoice):
             self.recorder.maybe_capture()
 
     def _support_height(self, xy: np.ndarray) -> float:
-        """Height (m) of the first surface below ``xy`` that is not the robot or the object."""
+        """Height (m) of the first surface below ``xy`` that is not the robot or the object. The ray
+        is vertical, so its hits come highest first and the first one not skipped is the highest of
+        them: the casts stop there."""
         skip = {self.obj, *(r.body_id for r in self.world.robots)}
         z = 0.0 if self.world.task.config.scene.ground else -math.inf
-        for hit in self.world.ray_hits([xy[0], xy[1], 5.0], [xy[0], xy[1], -1.0]):
-            if hit.body not in skip:
-                z = max(z, hit.position[2])
+        hit = self.world.first_ray_hit([xy[0], xy[1], 5.0], [xy[0], xy[1], -1.0], skip)
+        if hit is not None:
+            z = max(z, hit.position[2])
         return z if math.isfinite(z) else self.support_z
 
     def _check_placed(self) -> None:

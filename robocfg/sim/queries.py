@@ -7,7 +7,7 @@ by name or id. World frame, metres.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,10 +52,23 @@ class SceneQueries:
         past the hit doubles from 0.1 mm, never beyond the link's bounding box. Restarting past the
         bounding box at once skipped thin supports: a mesh's box carries Bullet's collision margin
         and reached through the top of a 5 cm stand under it."""
+        return list(self._ray_walk(start, end, max_hits))
+
+    def first_ray_hit(self, start: Sequence[float], end: Sequence[float], skip: Collection[int] = (),
+                      max_hits: int = 16) -> RayHit | None:
+        """The first hit of :meth:`ray_hits` (same arguments) whose body is not in ``skip`` (None
+        when there is none): the casts stop there, those past it are not made."""
+        for hit in self._ray_walk(start, end, max_hits):
+            if hit.body not in skip:
+                return hit
+        return None
+
+    def _ray_walk(self, start: Sequence[float], end: Sequence[float], max_hits: int) -> Iterator[RayHit]:
+        """:meth:`ray_hits`'s hits, nearest first, each cast made when the previous hit has been taken."""
         a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
         length = float(np.linalg.norm(b - a))
         if length == 0.0:
-            return []
+            return
         # Python floats from here (the same IEEE operations as the arrays' element by element,
         # without numpy's per-call cost on 3-vectors): the direction, and the ray's start per cast
         dx, dy, dz = d = ((b - a) / length).tolist()
@@ -63,7 +76,7 @@ class SceneQueries:
         to = b.tolist()
         axes = [k for k in range(3) if abs(d[k]) > 1e-12]
         ray, aabb, c = p.rayTest, p.getAABB, self.client
-        hits: list[RayHit] = []
+        found = 0
         seen: set[tuple[int, int]] = set()
         s, step, last = [ax, ay, az], 1e-4, (-1, -1)
         for _ in range(8 * max_hits):
@@ -76,8 +89,9 @@ class SceneQueries:
             hx, hy, hz = hit = h[3]
             if key not in seen:
                 seen.add(key)
-                hits.append(RayHit(key[0], (hx, hy, hz)))
-                if len(hits) >= max_hits:
+                found += 1
+                yield RayHit(key[0], (hx, hy, hz))
+                if found >= max_hits:
                     break
             lo, hi = aabb(h[0], h[1], physicsClientId=c)
             exits = [((hi[k] if d[k] > 0 else lo[k]) - hit[k]) / d[k] for k in axes]
@@ -85,7 +99,6 @@ class SceneQueries:
             s = [hx + m * dx, hy + m * dy, hz + m * dz]
             if (s[0] - ax) * dx + (s[1] - ay) * dy + (s[2] - az) * dz >= length:
                 break
-        return hits
 
     def closest_points(self, a: str | int, b: str | int, max_distance: float) -> list[PairPoint]:
         """Closest points of bodies ``a`` and ``b`` nearer than ``max_distance`` (m), per link pair."""
