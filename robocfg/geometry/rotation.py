@@ -26,20 +26,34 @@ def quat_to_matrix(q: Sequence[float] | np.ndarray) -> np.ndarray:
     One quaternion is converted in closed form with scipy's own arithmetic (the same bits as
     ``Rotation.from_quat(q).as_matrix()``, tested; ≈ 5× cheaper: it runs for every link pose
     read while simulating)."""
-    a = np.asarray(q, dtype=float)
-    if a.shape == (4,):
-        x, y, z, w = a.tolist()
-        n = math.sqrt(x * x + y * y + z * z + w * w)
-        if n > 0.0 and math.isfinite(n):
-            x, y, z, w = x / n, y / n, z / n, w / n
-            x2, y2, z2, w2 = x * x, y * y, z * z, w * w
-            xy, zw, xz, yw, yz, xw = x * y, z * w, x * z, y * w, y * z, x * w
-            return np.array([[x2 - y2 - z2 + w2, 2 * (xy - zw), 2 * (xz + yw)],
-                             [2 * (xy + zw), -x2 + y2 - z2 + w2, 2 * (yz - xw)],
-                             [2 * (xz - yw), 2 * (yz + xw), -x2 - y2 + z2 + w2]])
+    rows = quat_rows(q)
+    if rows is not None:
+        return np.array(rows)
     from scipy.spatial.transform import Rotation
 
-    return Rotation.from_quat(a).as_matrix()
+    return Rotation.from_quat(np.asarray(q, dtype=float)).as_matrix()
+
+
+def quat_rows(q: Sequence[float] | np.ndarray) -> list[list[float]] | None:
+    """The rows of :func:`quat_to_matrix` of one quaternion ``(x, y, z, w)`` as Python floats (the
+    same bits), or None where its closed form does not apply (not one quaternion, zero or not
+    finite): for code that reads a rotation's entries one by one."""
+    if type(q) is tuple and len(q) == 4:  # as PyBullet gives it: no array round trip
+        x, y, z, w = (float(v) for v in q)
+    else:
+        a = np.asarray(q, dtype=float)
+        if a.shape != (4,):
+            return None
+        x, y, z, w = a.tolist()
+    n = math.sqrt(x * x + y * y + z * z + w * w)
+    if not (n > 0.0 and math.isfinite(n)):
+        return None
+    x, y, z, w = x / n, y / n, z / n, w / n
+    x2, y2, z2, w2 = x * x, y * y, z * z, w * w
+    xy, zw, xz, yw, yz, xw = x * y, z * w, x * z, y * w, y * z, x * w
+    return [[x2 - y2 - z2 + w2, 2 * (xy - zw), 2 * (xz + yw)],
+            [2 * (xy + zw), -x2 + y2 - z2 + w2, 2 * (yz - xw)],
+            [2 * (xz - yw), 2 * (yz + xw), -x2 - y2 + z2 + w2]]
 
 
 def matrix_to_quat(R: np.ndarray) -> np.ndarray:

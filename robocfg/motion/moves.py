@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robocfg.errors import PhaseFailed
-from robocfg.geometry import rotation_angle
+from robocfg.motion.pose_goal import PoseGoal
 
 if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
@@ -183,15 +183,13 @@ class ArmMover:
         limit = self.time_limit(self._direct_duration(T_goal), REACTIVE_DETOUR)
         ctrl.reset(self.arm.joint_positions())
         t_start, still = self.world.t, np.zeros(6)
+        goal = PoseGoal(T_goal, self.position_tolerance, self.orientation_tolerance)
         while True:
-            T = self.arm.ee_pose()
-            dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
-            dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
-            if dp <= self.position_tolerance and dr <= self.orientation_tolerance:
+            pos, quat = self.arm.ee_position_quat()
+            if goal.reached(pos, quat):
                 break
             if self.world.t - t_start > limit:
-                raise MoveFailed(self.phase, f"did not converge within {limit:.1f} s "
-                                             f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
+                raise self._not_converged(goal, pos, quat, limit)
             res = ctrl.step(T_tcp, q_measured=self.arm.joint_positions(), velocity=still)
             self.arm.command(res.q, res.dq)
             self.step(drive.substeps)
@@ -252,17 +250,23 @@ class ArmMover:
         return float(MinJerkPath(np.asarray([q0, res.q]), self.limits).duration)
 
     def converge(self, T_goal: np.ndarray, t_start: float, limit: float | None = None) -> None:
+        """Poll every ``SETTLE_POLL`` steps until the EE is within tolerance of ``T_goal``
+        (:class:`~robocfg.motion.pose_goal.PoseGoal`); ``MoveFailed`` once ``limit`` s have passed
+        since ``t_start``."""
         limit = self.time_limit(None) if limit is None else limit
+        goal = PoseGoal(T_goal, self.position_tolerance, self.orientation_tolerance)
         while True:
-            T = self.arm.ee_pose()
-            dp = float(np.linalg.norm(T[:3, 3] - T_goal[:3, 3]))
-            dr = rotation_angle(T[:3, :3], T_goal[:3, :3])
-            if dp <= self.position_tolerance and dr <= self.orientation_tolerance:
+            pos, quat = self.arm.ee_position_quat()
+            if goal.reached(pos, quat):
                 return
             if self.world.t - t_start > limit:
-                raise MoveFailed(self.phase, f"did not converge within {limit:.1f} s "
-                                             f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
+                raise self._not_converged(goal, pos, quat, limit)
             self.step(SETTLE_POLL)
+
+    def _not_converged(self, goal: PoseGoal, pos, quat, limit: float) -> MoveFailed:
+        dp, dr = goal.errors_at(pos, quat)
+        return MoveFailed(self.phase, f"did not converge within {limit:.1f} s "
+                                      f"(error {dp * 1000:.1f} mm, {math.degrees(dr):.1f}°)")
 
     def close_until_held(self, body: int, timeout: float) -> None:
         """Close the gripper; wait until both fingers touch ``body`` and the measured width is still

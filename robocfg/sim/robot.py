@@ -324,6 +324,11 @@ class ArmHandle:
         """4x4 world pose of ``ee_link``."""
         return self.robot.link_pose(self.config.ee_link)
 
+    def ee_position_quat(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """(position m, quaternion x y z w) of ``ee_link`` in the world, as PyBullet gives them
+        (what :meth:`ee_pose` is built from, no matrix made)."""
+        return self.robot.link_position_quat(self.config.ee_link)
+
     def tcp_pose(self) -> np.ndarray:
         """4x4 world pose of the TCP: ``ee_link`` shifted by ``tcp_offset`` along its ``ee_axis``."""
         T = self.ee_pose()
