@@ -27,6 +27,8 @@ def test_values_and_derivatives_are_scipys_bits(bc):
         nus = [(0, 1), (1, 2), (0, 1, 2), (2, 0, 3, 1)][trial % 4]  # several at once, sharing the lookup
         for nu, b in zip(nus, ours.derivatives(xs, nus), strict=True):
             assert b.tobytes() == theirs(xs, nu).tobytes(), (trial, nus, nu)
+        for nu, b in zip(nus, ours.derivatives_by_column(xs, nus), strict=True):  # one row per column of y
+            assert b.shape == (y.shape[1], len(xs)) and b.T.tobytes() == theirs(xs, nu).tobytes(), (trial, nus, nu)
         s = np.float64(x[-1] * 0.37)
         assert ours(s).shape == theirs(s).shape and ours(s).tobytes() == theirs(s).tobytes()
 
@@ -46,3 +48,5 @@ def test_refuses_what_it_does_not_implement():
         CubicSpline(x[::-1], y, bc_type="natural")
     with pytest.raises(ValueError):
         CubicSpline(x, y, bc_type="clamped")  # type: ignore[arg-type]
+    with pytest.raises(ValueError):
+        CubicSpline(x, y, bc_type="natural").derivatives_by_column(np.zeros((2, 2)), (0,))

@@ -19,5 +19,9 @@ def test_positions_velocities_are_evaluates_bits(k):
     t = np.arange(1, int(path.duration * 240) + 5) / 240  # past the end too (clipped)
     q, qd = path.positions_velocities(t)
     q_ref, qd_ref, _ = path.evaluate(t)
-    assert np.array_equal(q, q_ref) and np.array_equal(qd, qd_ref)
+    assert q.shape == q_ref.shape and qd.shape == qd_ref.shape
+    assert q.tobytes() == q_ref.tobytes() and qd.tobytes() == qd_ref.tobytes()
+    t_few = np.linspace(-0.1, path.duration + 0.1, 41)
+    assert path.positions(t_few).tobytes() == path.evaluate(t_few)[0].tobytes()  # what a move's FK check samples
+    assert path.positions(t_few).flags.c_contiguous
     assert np.allclose(q[-1], W[-1], atol=1e-12) and np.abs(qd).max() > 0.1  # it moved, and ends at the goal

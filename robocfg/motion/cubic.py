@@ -65,6 +65,7 @@ class CubicSpline:
         s = _solve_tridiagonal(A, b)
         t = (s[:-1] + s[1:] - 2 * slope) / dxr
         self.x = x
+        self._c_by_column: np.ndarray | None = None  # self.c as (4, n, k-1), made on first evaluation
         self.c = np.stack((t / dxr, (slope - s[:-1]) / dxr - t, s[:-1], y[:-1]))  # (4, k-1, n), highest power first
 
     def __call__(self, xs, nu: int = 0) -> np.ndarray:
@@ -72,40 +73,70 @@ class CubicSpline:
         return self.derivatives(xs, (nu,))[0]
 
     def derivatives(self, xs, nus: tuple[int, ...]) -> list[np.ndarray]:
-        """``[spline(xs, nu) for nu in nus]``, the same values bit for bit, with the pieces'
-        lookup, their coefficients at ``xs`` and the powers of the local coordinate made once."""
+        """``[spline(xs, nu) for nu in nus]``, the same values bit for bit (C-ordered arrays of
+        shape ``xs.shape + (n,)``): :meth:`derivatives_by_column` transposed."""
         xs = np.asarray(xs, dtype=np.float64)
-        flat = xs.ravel()
+        n = self.c.shape[2]
+        return [np.ascontiguousarray(r.T).reshape(*xs.shape, n) for r in self.derivatives_by_column(xs.ravel(), nus)]
+
+    def derivatives_by_column(self, xs, nus: tuple[int, ...]) -> list[np.ndarray]:
+        """``[spline(xs, nu).T for nu in nus]`` for 1-D ``xs``: arrays of shape (n, len(xs)), one
+        row per column of ``y``, the same values bit for bit as scipy's. scipy's evaluation
+        (``res = res + c * z * prefactor`` over the powers, from ``res = 0.0``) runs along the
+        points, with the pieces' lookup, their coefficients at ``xs`` (one gather of all of them)
+        and the powers of the local coordinate made once and each sum built in place."""
+        flat = np.asarray(xs, dtype=np.float64)
+        if flat.ndim != 1:
+            raise ValueError("CubicSpline.derivatives_by_column: 1-D xs only")
+        if self._c_by_column is None:  # (order, n, pieces): each coefficient's rows run along the points
+            self._c_by_column = np.ascontiguousarray(self.c.transpose(0, 2, 1))
+        c = self._c_by_column
+        order, n = c.shape[0], c.shape[1]
         # np.clip's bounds checks cost more than the search on these small arrays; the same ints
         i = np.minimum(np.maximum(np.searchsorted(self.x, flat, side="right") - 1, 0), len(self.x) - 2)
-        s = (flat - self.x[i])[:, None]
-        order = self.c.shape[0]
-        coef: list[np.ndarray | None] = [None] * order  # the coefficient of s**kp at each point, gathered when first needed
+        s = flat - self.x[i]
+        coefs = c.take(i, axis=2)  # (order, n, points): coefs[order - kp - 1] multiplies s**kp
         powers: list[np.ndarray | None] = [None]  # s**m built as (s*s)*s...; None stands for scipy's exact 1.0
         nan = np.isnan(flat)
+        has_nan = bool(nan.any())
         out = []
+        tmp: np.ndarray | None = None
         for nu in nus:
             res: np.ndarray | None = None
             for kp in range(nu, order):
                 prefactor = 1.0
                 for k in range(kp, kp - nu, -1):
                     prefactor *= k
-                term = coef[kp]
-                if term is None:
-                    term = coef[kp] = self.c[order - kp - 1][i]
+                coef = coefs[order - kp - 1]
                 m = kp - nu  # scipy: res = res + c * z * prefactor, z = s**m (x * 1.0 is x, bit for bit)
                 while len(powers) <= m:
                     powers.append(s if len(powers) == 1 else powers[-1] * s)
                 z = powers[m]
+                # term = coef * z * prefactor, into a new array (the first term becomes res) or tmp
+                buf = None if res is None else tmp
                 if z is not None:
-                    term = term * z
-                if prefactor != 1.0:
-                    term = term * prefactor
-                res = term + 0.0 if res is None else res + term  # scipy starts from res = 0.0
+                    term = np.multiply(coef, z, out=buf)
+                    if prefactor != 1.0:
+                        term *= prefactor
+                elif prefactor != 1.0:
+                    term = np.multiply(coef, prefactor, out=buf)
+                else:
+                    term = coef  # a view of coefs: never written to
+                if res is None:  # scipy starts from res = 0.0: term + 0.0
+                    if term is coef:
+                        res = coef + 0.0
+                    else:
+                        term += 0.0
+                        res = term
+                    if tmp is None:
+                        tmp = np.empty_like(res)
+                else:
+                    res += term
             if res is None:
-                res = np.zeros((len(flat), self.c.shape[2]))
-            res[nan] = np.nan  # scipy: NaN in, NaN out (every derivative)
-            out.append(res.reshape(*xs.shape, self.c.shape[2]))
+                res = np.zeros((n, len(flat)))
+            if has_nan:
+                res[:, nan] = np.nan  # scipy: NaN in, NaN out (every derivative)
+            out.append(res)
         return out
 
 

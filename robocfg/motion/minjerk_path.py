@@ -73,13 +73,31 @@ class MinJerkPath(Trajectory):
         self.duration = float(max(t_vel, t_acc, min_duration))
 
     def positions_velocities(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """``evaluate(t)``'s (q, qd) by the same arithmetic, without the accelerations."""
-        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
-        tau = np.clip(tt / self.duration, 0.0, 1.0)
-        s = tau**3 * (10 - 15 * tau + 6 * tau**2)
+        """``evaluate(t)``'s (q, qd) by the same arithmetic, without the accelerations. A spline's
+        are evaluated a joint at a time along the times (:meth:`CubicSpline.derivatives_by_column`)
+        and come back as the transposes of those (n, N) arrays (the same values; not C-ordered)."""
+        tau, s = self._law(t)
         sd = 30 * tau**2 * (1 - tau) ** 2 / self.duration
+        if isinstance(self.spline, CubicSpline) and s.ndim == 1:
+            q, d1 = self.spline.derivatives_by_column(s, (0, 1))
+            d1 *= sd  # d1 is new: scaled in place, each element as d1 * sd[:, None] scales it
+            return q.T, d1.T
         q, d1 = self.spline.derivatives(s, (0, 1))
         return q, d1 * sd[:, None]
+
+    def positions(self, t) -> np.ndarray:
+        """``evaluate(t)``'s q by the same arithmetic (C-ordered), without the derivatives."""
+        _, s = self._law(t)
+        if isinstance(self.spline, CubicSpline) and s.ndim == 1:
+            return np.ascontiguousarray(self.spline.derivatives_by_column(s, (0,))[0].T)
+        return self.spline.derivatives(s, (0,))[0]
+
+    def _law(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """(τ, s) of the min-jerk law at times ``t`` (s; clipped to [0, duration]), as ``_eval``
+        computes them."""
+        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
+        tau = np.clip(tt / self.duration, 0.0, 1.0)
+        return tau, tau**3 * (10 - 15 * tau + 6 * tau**2)
 
     def _eval(self, t):
         T = self.duration

@@ -214,8 +214,7 @@ class ArmMover:
         FK at ``ACCEL_SAMPLES`` instants, second differences) stays within ``a_max``: time scaled
         by c scales accelerations by 1/c²."""
         t = np.linspace(0.0, traj.duration, ACCEL_SAMPLES)
-        q, _, _ = traj.evaluate(t)
-        P = self.model.fk_positions(q, "ee")
+        P = self.model.fk_positions(traj.positions(t), "ee")
         peak = float(np.linalg.norm(np.diff(P, 2, axis=0), axis=1).max()) / (t[1] - t[0]) ** 2
         return max(1.0, math.sqrt(peak / max(a_max, MIN_ACCELERATION)))
 

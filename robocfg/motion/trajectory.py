@@ -31,6 +31,11 @@ class Trajectory:
         q, qd, _ = self.evaluate(t)
         return q, qd
 
+    def positions(self, t) -> np.ndarray:
+        """q at times ``t``, the same values as ``evaluate``'s first; a subclass may skip the
+        derivatives."""
+        return self.evaluate(t)[0]
+
     def _eval(self, t: np.ndarray):  # pragma: no cover - abstract
         raise NotImplementedError
 
