@@ -213,8 +213,9 @@ class _StateMachine(GraspChoice):
         drags the object up with them)."""
         t0 = self.world.t
         self.gripper.open()
-        last, still = self.gripper.fraction(), 0.0
-        while self._held() or self.gripper.fraction() < 0.9:
+        now = last = self.gripper.fraction()  # the opening measured once per poll (no joint moves between)
+        still = 0.0
+        while self._held() or now < 0.9:
             if self.world.t - t0 > self.params.timeouts.release:
                 raise MoveFailed("release", "the object did not come free")
             self.mover.step(SETTLE_POLL)

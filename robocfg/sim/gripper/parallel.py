@@ -47,6 +47,10 @@ class ParallelGripper(Gripper):
         self.fingers = [self.robot.link(n) for n in cfg.finger_links]
         self.rate = rate
         self.force = cfg.max_force
+        self._joint_indices = self.robot.joint_indices(self.joints)
+        # (closed position, open − closed) per driven joint as Python floats, for fraction(); None: numpy's mean
+        terms = [(float(c), float(o - c)) for c, o in zip(self.q_closed, self.q_open, strict=True)]
+        self._fraction_terms = terms if len(terms) in (1, 2) and all(span != 0.0 for _, span in terms) else None
         gains = self.robot.config.drives.arm
         self._gains = (gains.stiffness, gains.damping)
         # A soft pad pressed on an object touches it over a patch, not at a point: uniform pressure over a
@@ -153,9 +157,19 @@ class ParallelGripper(Gripper):
         return max(0.0, float(min(c[8] for c in pts)))
 
     def fraction(self) -> float:
-        """Measured opening fraction of the driven joints (0 closed, 1 open), averaged."""
-        q = self.robot.joint_positions(self.joints)
-        return float(np.mean((q - self.q_closed) / (self.q_open - self.q_closed)))
+        """Measured opening fraction of the driven joints (0 closed, 1 open), averaged. One or two
+        driven joints (every gripper shipped) in Python floats: the same IEEE operations as the
+        arrays' (a mean of two is their sum halved in any order)."""
+        if self._fraction_terms is None:
+            return float(np.mean((self.robot.joint_positions(self.joints) - self.q_closed) / (self.q_open - self.q_closed)))
+        states = p.getJointStates(self.robot.body_id, self._joint_indices, physicsClientId=self.client)
+        if len(states) == 1:
+            ((q, *_),) = states
+            ((lo, span),) = self._fraction_terms
+            return (q - lo) / span  # the mean of one value is itself
+        (qa, *_), (qb, *_) = states
+        (la, sa), (lb, sb) = self._fraction_terms
+        return ((qa - la) / sa + (qb - lb) / sb) / 2
 
     def state(self) -> float:
         """1.0 (open) when the measured fraction exceeds ``state_threshold``, else −1.0 (closed)."""
@@ -174,9 +188,11 @@ class ParallelGripper(Gripper):
         return True
 
     def is_grasping(self, body: int | str) -> bool:
-        """Both finger links touch ``body`` (a body id or a world body name)."""
-        bid = self._body_id(body)
-        return all(p.getContactPoints(self.robot.body_id, bid, f, physicsClientId=self.client) for f in self.fingers)
+        """Both finger links touch ``body`` (a body id or a world body name): each has a contact
+        point of the last step with it (one query of the robot's contacts with the body)."""
+        pts = p.getContactPoints(self.robot.body_id, self._body_id(body), physicsClientId=self.client)
+        links = {c[3] for c in pts}  # the robot's link of each point (PyBullet puts the asked body A first)
+        return all(f in links for f in self.fingers)
 
 
 def _width_curve(checked: CheckedRobot, arm_cfg: ArmConfig) -> tuple[np.ndarray, np.ndarray] | None:
