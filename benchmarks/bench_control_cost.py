@@ -61,6 +61,8 @@ BUCKETS = (  # (module, class or None for a module function, function, label); e
     ("robocfg.motion.minjerk_path", "MinJerkPath", "__init__", "min-jerk timing"),
     ("robocfg.motion.minjerk_path", "MinJerkPath", "positions_velocities", "trajectory sampling"),
     ("robocfg.motion.trajectory", "Trajectory", "evaluate", "trajectory sampling"),
+    ("robocfg.motion.minjerk_path", "MinJerkPath", "positions", "trajectory sampling"),
+    ("robocfg.motion.trajectory", "Trajectory", "positions", "trajectory sampling"),
     ("robocfg.sim.gripper.parallel", "ParallelGripper", "update", "gripper update"),
     # the rest of the episode, by part ("other" is what none of these holds):
     ("robocfg.sim.playback", None, "_play_bare", "step loop"),
@@ -88,6 +90,7 @@ BUCKETS = (  # (module, class or None for a module function, function, label); e
     ("robocfg.runners.pick_place", None, "episode_setup", "episode set-up"),
     ("robocfg.runners.pick_place_machine", "_StateMachine", "__init__", "episode set-up"),
     ("robocfg.sim.robot", "RobotHandle", "link_pose", "state reads"),
+    ("robocfg.sim.robot", "RobotHandle", "link_position_quat", "state reads"),
     ("robocfg.sim.robot", "RobotHandle", "joint_positions", "state reads"),
     ("robocfg.sim.world", "World", "body_pose", "state reads"),
     ("robocfg.runners.pick_place_machine", "_StateMachine", "result", "episode record"),
@@ -146,7 +149,9 @@ class Meter:
             self.wrap(pybullet, "stepSimulation", "stepSimulation")
             for mod, cls, fn, label in BUCKETS:
                 m = importlib.import_module(mod)
-                self.wrap(m if cls is None else getattr(m, cls), fn, label)
+                holder = m if cls is None else getattr(m, cls)
+                if hasattr(holder, fn):  # (an older version of the code, measured for comparison, may lack it)
+                    self.wrap(holder, fn, label)
         for holder, name, _, f, label in self._wrapped:
             if physics_only and label != "stepSimulation":
                 continue
