@@ -68,7 +68,7 @@ def test_play_is_bit_for_bit_the_per_step_loop(tmp_path):
 def test_play_answers_a_stop_request_like_step(tmp_path):
     played, looped = _run(tmp_path, "play", stop_at=50), _run(tmp_path, "loop", stop_at=50)
     assert played == looped
-    assert played[3] is not None and played[3][0] == 50  # at the first check at or after step 50
+    assert played[3] is not None and played[3][0] == 60  # at the first check at or after step 50
 
 
 def _state_at_home(tmp_path):
@@ -145,9 +145,9 @@ def test_bare_loops_are_bit_for_bit_the_per_step_loop(tmp_path, case):
     fast, slow = _run_bare(tmp_path, "fast", **case), _run_bare(tmp_path, "slow", **case)
     assert fast == slow
     state, steps, t, checked, ended, _ = fast
-    assert checked and all(s % 5 == 0 for s in checked)  # every 20 ms of simulated time at 240 Hz
+    assert checked and all(s % 12 == 0 for s in checked)  # every 50 ms of simulated time at 240 Hz
     if "stop_at" in case:
-        assert ended is not None and ended[:2] == ("RunInterrupted", 50)
+        assert ended is not None and ended[:2] == ("RunInterrupted", 60)  # the first check at or after 50
     elif "max_joint_velocity" in case:
         assert ended is not None and ended[0] == "PhysicsDiverged" and ended[1] == checked[-1]
     else:

@@ -22,7 +22,9 @@ from robocfg.errors import RobocfgError
 
 
 def steps_per_frame(dt: float, fps: float) -> int:
-    """Physics steps per dataset frame; the dataset rate must divide the physics rate."""
+    """Physics steps per dataset frame; the dataset rate must divide the physics rate. At the
+    default 20 Hz a frame falls on every divergence check (``World.check_every``, 50 ms), after it;
+    at other rates a frame off that grid is checked itself (``EpisodeRecorder._frame``)."""
     n = round(1.0 / (fps * dt))
     if n < 1 or abs(n * dt * fps - 1.0) > 1e-6:
         raise RobocfgError(f"--dataset-fps {fps:g} does not divide the physics rate {1 / dt:g} Hz; "
@@ -113,6 +115,9 @@ class EpisodeRecorder:
         self.gate.remove()
 
     def _frame(self, first: bool = False) -> None:
+        w = self.world
+        if not first and w.steps % w.check_every:  # a rate off the check grid (not a divisor of 20 Hz):
+            w.check()  # every frame shows a checked state (PhysicsDiverged before a NaN is recorded)
         k = len(self.actions)
         replay = self.replay_actions
         if replay is not None:  # past the recorded frames the last action holds

@@ -294,7 +294,10 @@ class _StateMachine(GraspChoice):
 
     def _tilt(self, quat) -> float:
         """Degrees the object has tipped from how it lay at the start (yaw free; see
-        :meth:`~robocfg.assets.object_shape.ObjectShape.tilt_deg`)."""
+        :meth:`~robocfg.assets.object_shape.ObjectShape.tilt_deg`); NaN for a diverged body's
+        non-finite quaternion (the episode failed with ``PhysicsDiverged``: its record is still made)."""
+        if not all(math.isfinite(v) for v in quat):
+            return math.nan
         return self.shape.tilt_deg(self.R0, quat_to_matrix(quat))
 
     def result(self, failed: str | None, reason: str) -> EpisodeResult:
