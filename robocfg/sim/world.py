@@ -16,11 +16,11 @@ a stop request (Ctrl-C) is answered at the same checks).
 Why 50 ms (``CHECK_INTERVAL``): it is the dataset frame period at the default 20 Hz, and checks
 and frames fall on the same steps (both where ``steps`` is a multiple of the period), the check
 first: every recorded frame shows a state that passed the check at that very step (at 20 ms,
-four frames in five were sampled 2–7 steps after the last check). What a divergence does in
+four frames in five were sampled 1–4 steps after the last check). What a divergence does in
 between was measured (PyBullet 3.2.7, pick-place world): a NaN joint velocity turns every joint
 of that robot NaN at the next step, a NaN or absurd object velocity stays in that body, and
 steps go on at their usual cost (no hang, no crash), so checking 12 steps apart instead of 5
-only moves the reported time by up to 30 ms of simulated time (≈ 1 ms of CPU). A check costs a
+only moves the reported time by up to 30 ms of simulated time (7 steps, ≈ 0.5 ms of CPU). A check costs a
 state query per robot and per free body (≈ 5–8 µs, mostly PyBullet copying its fixed-size state
 buffer per query): in a pick-place episode, ≈ 1.9 % of the physics' instructions every 20 ms,
 ≈ 0.8 % every 50 ms (callgrind).
