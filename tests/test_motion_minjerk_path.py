@@ -25,3 +25,44 @@ def test_positions_velocities_are_evaluates_bits(k):
     assert path.positions(t_few).tobytes() == path.evaluate(t_few)[0].tobytes()  # what a move's FK check samples
     assert path.positions(t_few).flags.c_contiguous
     assert np.allclose(q[-1], W[-1], atol=1e-12) and np.abs(qd).max() > 0.1  # it moved, and ends at the goal
+
+
+@pytest.mark.parametrize("k", [2, 3, 4, 5, 9])
+def test_duration_keeps_velocities_and_accelerations_within_the_limits(k):
+    """The duration is a true bound: sampled densely (2000 instants), no joint's speed or
+    acceleration exceeds its limit, and the bound is not loose (one of them comes within 10 %)."""
+    rng = np.random.default_rng(100 + k)
+    for trial in range(20):
+        W = np.cumsum(rng.normal(0.0, 0.3, (k, 6)), axis=0)
+        limits = JointLimits(names=tuple("abcdef"), lower=np.full(6, -9.0), upper=np.full(6, 9.0),
+                             velocity=rng.uniform(0.5, 3.0, 6), acceleration=rng.uniform(1.0, 10.0, 6))
+        path = MinJerkPath(W, limits)
+        _, qd, qdd = path.evaluate(np.linspace(0.0, path.duration, 2000))
+        v, a = np.abs(qd).max(axis=0) / limits.velocity, np.abs(qdd).max(axis=0) / limits.acceleration
+        assert v.max() <= 1 + 1e-9 and a.max() <= 1 + 1e-9, (k, trial)
+        if k == 2:
+            assert max(v.max(), a.max()) > 0.999, trial
+
+
+@pytest.mark.parametrize("k", [3, 4])
+def test_few_waypoints_give_scipys_not_a_knot_spline_and_exact_derivative_bounds(k):
+    """Three or four waypoints: the one polynomial through them is scipy's not-a-knot spline (to
+    rounding), and the derivative maxima the duration uses are the true ones (20001 samples)."""
+    from scipy.interpolate import CubicSpline as ScipySpline
+
+    from robocfg.motion.minjerk_path import derivative_bounds, joint_path
+
+    rng = np.random.default_rng(k)
+    for _ in range(100):
+        W = np.cumsum(rng.normal(size=(k, 6)), axis=0)
+        _, path = joint_path(W)
+        x = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(W, axis=0), axis=1))])
+        ref = ScipySpline(x / x[-1], W, bc_type="not-a-knot")
+        s = np.linspace(0.0, 1.0, 101)
+        for nu in range(4):
+            assert np.allclose(path(s, nu), ref(s, nu), rtol=0, atol=1e-8 * (1 + np.abs(ref(s, nu)).max()))
+        d1, d2 = derivative_bounds(path)
+        dense = np.linspace(0.0, 1.0, 20001)
+        assert np.all(d1 >= np.abs(ref(dense, 1)).max(axis=0) - 1e-9)
+        assert np.all(d1 <= np.abs(ref(dense, 1)).max(axis=0) * (1 + 1e-6) + 1e-9)
+        assert np.allclose(d2, np.abs(ref(dense, 2)).max(axis=0))

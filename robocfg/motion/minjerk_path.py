@@ -3,8 +3,9 @@ a minimum-jerk time law s(τ) = 10τ³ − 15τ⁴ + 6τ⁵.
 
 Not time-optimal (toppra is, see :mod:`robocfg.motion.timing`), but it costs ~0.1 ms instead of
 10–30 ms, which matters for controllers that plan every phase of every episode (pick-place). The
-duration is the smallest one for which the sampled joint velocities and accelerations stay within
-the limits (a bound that is tight at the peak of the time law). Units: rad, s.
+duration is the smallest one for which the joint velocities and accelerations stay within the
+limits by a bound from the path's exact derivative maxima (tight at the peak of the time law).
+Units: rad, s.
 """
 
 from __future__ import annotations
@@ -17,7 +18,6 @@ from robocfg.motion.trajectory import Trajectory
 
 PEAK_SPEED = 1.875  # max ds/dτ of the min-jerk law
 PEAK_ACCEL = 5.7735  # max |d²s/dτ²| of the min-jerk law
-SAMPLES = 64
 
 
 class _Segment:
@@ -41,33 +41,116 @@ class _Segment:
         return [self(s, nu) for nu in nus]
 
 
-class MinJerkPath(Trajectory):
-    """q(t) = spline(s(t / T)), rest to rest, through ``waypoints`` (k, n) with k ≥ 2 (two: the
-    straight segment, no spline built)."""
+class _Cubic:
+    """The one polynomial of degree ≤ 3 through three or four waypoints at knots ``x`` (0 … 1):
+    what scipy's not-a-knot ``CubicSpline`` is for so few points (its interior knots are not
+    knots), from Newton's divided differences, without the banded solve. ``c`` (4, 1, n) and
+    ``x`` = [0, 1] in ``CubicSpline``'s layout (highest power first), one piece; ``path(s, order)``
+    by Horner's rule."""
 
-    def __init__(self, waypoints: np.ndarray, limits: JointLimits, min_duration: float = 0.05):
-        W = np.array(waypoints, dtype=float)  # a copy: the path keeps its own waypoints
-        seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
-        moved = seg > 1e-9
-        if len(W) < 2 or not moved.all():  # repeated waypoints dropped (else W and seg stay as they are)
-            W = W[np.concatenate([[True], moved])]
-            if len(W) < 2:
-                W = np.vstack([W, W])
-                seg = np.array([1.0])
-            else:
-                seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
-        self.waypoints = W
-        self.spline: _Segment | CubicSpline
-        if len(W) == 2:  # a straight segment: linear in s
-            self.spline = _Segment(W)
-            d1, d2 = np.abs(W[1] - W[0]), np.zeros(W.shape[1])
+    def __init__(self, x: np.ndarray, W: np.ndarray):
+        f01 = (W[1] - W[0]) / (x[1] - x[0])
+        f12 = (W[2] - W[1]) / (x[2] - x[1])
+        f012 = (f12 - f01) / (x[2] - x[0])
+        if len(W) == 4:
+            f23 = (W[3] - W[2]) / (x[3] - x[2])
+            f0123 = ((f23 - f12) / (x[3] - x[1]) - f012) / (x[3] - x[0])
         else:
-            knots = np.concatenate([[0.0], np.cumsum(seg)])
-            knots /= knots[-1]
-            self.spline = CubicSpline(knots, W, axis=0, bc_type="not-a-knot" if len(W) > 3 else "natural")
-            s = np.linspace(0.0, 1.0, SAMPLES)
-            v1, v2 = self.spline.derivatives(s, (1, 2))
-            d1, d2 = np.abs(v1).max(axis=0), np.abs(v2).max(axis=0)
+            f0123 = np.zeros_like(f012)
+        x1, x2 = float(x[1]), float(x[2]) if len(W) == 4 else 0.0  # x[0] = 0
+        # W0 + f01·s + f012·s(s − x1) + f0123·s(s − x1)(s − x2), in powers of s
+        self.c = np.stack((f0123, f012 - f0123 * (x1 + x2), f01 - f012 * x1 + f0123 * x1 * x2, W[0]))[:, None, :]
+        self.x = np.array([0.0, 1.0])
+
+    def __call__(self, s, order: int = 0) -> np.ndarray:
+        return self.derivatives(s, (order,))[0]
+
+    def derivatives(self, s, nus: tuple[int, ...]) -> list[np.ndarray]:
+        """``[path(s, nu) for nu in nus]`` (the interface of :meth:`CubicSpline.derivatives`)."""
+        s = np.asarray(s, dtype=float)[..., None]
+        a, b, c, d = self.c[:, 0]
+        out = []
+        for nu in nus:
+            if nu == 0:
+                out.append(((a * s + b) * s + c) * s + d)
+            elif nu == 1:
+                out.append((3 * a * s + 2 * b) * s + c)
+            elif nu == 2:
+                out.append(6 * a * s + 2 * b)
+            else:
+                out.append(np.broadcast_to(6 * a if nu == 3 else 0 * a, s.shape[:-1] + a.shape).copy())
+        return out
+
+
+JointSpline = _Segment | _Cubic | CubicSpline
+
+
+def joint_path(waypoints: np.ndarray) -> tuple[np.ndarray, JointSpline]:
+    """The geometric joint path a :class:`MinJerkPath` through ``waypoints`` (k, n) plays:
+    ``(kept waypoints, path)`` with ``path(s, order)`` for s ∈ [0, 1] (chord-length knots in joint
+    space). Repeated waypoints are dropped; two left: the straight segment (no spline built);
+    three or four: the one polynomial through them (scipy's not-a-knot spline for so few points);
+    more: a not-a-knot cubic spline."""
+    W, path, _ = joint_path_knots(waypoints)
+    return W, path
+
+
+def joint_path_knots(waypoints: np.ndarray) -> tuple[np.ndarray, JointSpline, np.ndarray]:
+    """:func:`joint_path` and the path's parameter at each kept waypoint (0 … 1)."""
+    W = np.array(waypoints, dtype=float)  # a copy: the path keeps its own waypoints
+    seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
+    moved = seg > 1e-9
+    if len(W) < 2 or not moved.all():  # repeated waypoints dropped (else W and seg stay as they are)
+        W = W[np.concatenate([[True], moved])]
+        if len(W) < 2:
+            W = np.vstack([W, W])
+            seg = np.array([1.0])
+        else:
+            seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
+    if len(W) == 2:  # a straight segment: linear in s
+        return W, _Segment(W), np.array([0.0, 1.0])
+    knots = np.concatenate([[0.0], np.cumsum(seg)])
+    knots /= knots[-1]
+    if len(W) <= 4:
+        return W, _Cubic(knots, W), knots
+    return W, CubicSpline(knots, W, axis=0, bc_type="not-a-knot"), knots
+
+
+def derivative_bounds(path: JointSpline) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint, the exact maxima of |dq/ds| and |d²q/ds²| over s ∈ [0, 1]: on each cubic
+    piece the second derivative is linear (largest at an end) and the first quadratic (largest at
+    an end or at its vertex)."""
+    if isinstance(path, _Segment):
+        return np.abs(path.delta), np.zeros(len(path.delta))
+    if isinstance(path, _Cubic):  # one piece on [0, 1], a few joints: scalar arithmetic is cheaper
+        d1, d2 = [], []
+        for a, b, c in zip(*path.c[:3, 0].tolist(), strict=True):  # a·s³ + b·s² + c·s + d
+            m = max(abs(c), abs(3 * a + 2 * b + c))
+            if a != 0.0 and 0.0 < -b / (3 * a) < 1.0:
+                m = max(m, abs(c - b * b / (3 * a)))
+            d1.append(m)
+            d2.append(max(abs(2 * b), abs(6 * a + 2 * b)))
+        return np.array(d1), np.array(d2)
+    c3, c2, c1 = path.c[0], path.c[1], path.c[2]  # (pieces, n): c3·t³ + c2·t² + c1·t + c0, t ∈ [0, h]
+    h = np.diff(path.x)[:, None]
+    d2 = np.maximum(np.abs(2 * c2), np.abs(6 * c3 * h + 2 * c2)).max(axis=0)
+    vertex = np.clip(np.divide(-c2, 3 * c3, out=np.zeros_like(c3), where=c3 != 0), 0.0, h)
+    d1 = np.maximum.reduce([np.abs(c1), np.abs((3 * c3 * h + 2 * c2) * h + c1),
+                            np.abs((3 * c3 * vertex + 2 * c2) * vertex + c1)]).max(axis=0)
+    return d1, d2
+
+
+class MinJerkPath(Trajectory):
+    """q(t) = path(s(t / T)), rest to rest, through ``waypoints`` (k, n) with k ≥ 2 (the path of
+    :func:`joint_path`). The duration is the least for which the joint velocities and
+    accelerations stay within ``limits`` — a true bound, from the path's exact derivative maxima
+    (:func:`derivative_bounds`) and the time law's peaks; ``path`` is the already-built
+    ``joint_path(waypoints)`` when the caller has it (a straight line checked by FK)."""
+
+    def __init__(self, waypoints: np.ndarray, limits: JointLimits, min_duration: float = 0.05,
+                 path: tuple[np.ndarray, JointSpline] | None = None):
+        self.waypoints, self.spline = joint_path(waypoints) if path is None else path
+        d1, d2 = derivative_bounds(self.spline)
         t_vel = PEAK_SPEED * np.max(d1 / limits.velocity)
         t_acc = np.sqrt(np.max((d2 * PEAK_SPEED**2 + d1 * PEAK_ACCEL) / limits.acceleration))
         self.duration = float(max(t_vel, t_acc, min_duration))

@@ -1,9 +1,9 @@
 """Arm moves shared by the grasping runners: IK to EE poses (continuous along straight lines),
 min-jerk timing, trajectory following, convergence checks, and close-until-held.
 
-Used by pick-place and grasp: ``ArmMover.move(T_goal, straight=...)`` plans IK waypoints every
-``CARTESIAN_STEP`` m along a straight EE line (or, for a joint-space move, the IK answer nearest
-the current joints), times them with ``MinJerkPath``, sends position + velocity targets every
+Used by pick-place and grasp: ``ArmMover.move(T_goal, straight=...)`` plans joint waypoints along
+a straight EE line, as few as keep the played path on the line by FK (``robocfg.motion.straight_line``;
+or, for a joint-space move, the IK answer nearest the current joints), times them with ``MinJerkPath``, sends position + velocity targets every
 physics step, and waits until the EE is within tolerance (``move_reactive`` instead steps a
 follow-target controller that avoids the scene, with the same checks). Failures raise
 ``MoveFailed(phase, reason)``. Poses are world_T_ee (4x4, m).
@@ -30,14 +30,13 @@ if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import JointLimits
+    from robocfg.motion.minjerk_path import JointSpline
     from robocfg.motion.trajectory import Trajectory
     from robocfg.sim.gripper.base import Gripper
     from robocfg.sim.robot import ArmHandle
     from robocfg.sim.world import World
 
-CARTESIAN_STEP = 0.03  # m between IK waypoints on straight lines
 SETTLE_POLL = 4  # physics steps between convergence checks
-MAX_JOINT_JUMP = 0.5  # rad between consecutive IK waypoints on a straight line (a branch flip)
 DIRECT_TRAVEL_CHECK = 1.0  # rad: a point-to-point IK answer this far away is compared with a continuous one
 TIMEOUT_FACTOR = 1.25  # a move without a fixed timeout may take its planned duration × this ...
 TIMEOUT_MARGIN = 1.0  # ... + this many seconds (s) to settle and converge
@@ -116,28 +115,20 @@ class ArmMover:
                                       f"{math.degrees(res.rot_err):.1f}°)")
 
     def straight_waypoints(self, q0: np.ndarray, T_goal: np.ndarray) -> np.ndarray:
-        """Joint waypoints along the straight EE line from FK(q0) to ``T_goal`` (orientation of the goal)."""
-        T0 = self.model.fk(q0, "ee")
-        p0, p1 = T0[:3, 3], T_goal[:3, 3]
-        n = max(2, math.ceil(np.linalg.norm(p1 - p0) / CARTESIAN_STEP) + 1)
-        waypoints, q = [q0], q0
+        """Joint waypoints (k, n) along the straight EE line from FK(q0) to ``T_goal`` (orientation
+        of the goal) whose played path stays on the line (:mod:`robocfg.motion.straight_line`)."""
+        return self.straight_path(q0, T_goal)[0]
+
+    def straight_path(self, q0: np.ndarray, T_goal: np.ndarray) -> tuple[np.ndarray, JointSpline]:
+        """:meth:`straight_waypoints` and the joint path through them (for ``MinJerkPath``)."""
+        from robocfg.motion.straight_line import straight_line_path
+
         # straight to the solver, not through the answers remembered by self.ik: the points of a
-        # line are asked from the line's own previous answer, never twice in an episode
+        # line are asked from the line's own seeds, never twice in an episode
         ik, budget = self.model.ik, self.ik_budget
-        (x0, y0, z0), (x1, y1, z1) = p0.tolist(), p1.tolist()
-        for s in np.linspace(0, 1, n)[1:].tolist():
-            T = T_goal.copy()
-            T[:3, 3] = ((1 - s) * x0 + s * x1, (1 - s) * y0 + s * y1, (1 - s) * z0 + s * z1)  # as the arrays would
-            res = ik(T, seed_q=q, frame="ee", time_budget=budget)  # self.solve, its message made on failure only
-            if not res.converged:
-                raise self._unreachable(res, f" at {s:.0%} of the straight line")
-            q_next = res.q
-            jump = float(np.max(np.abs(q_next - q)))
-            if jump > MAX_JOINT_JUMP:
-                raise MoveFailed(self.phase, f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at {s:.0%})")
-            q = q_next
-            waypoints.append(q)
-        return np.asarray(waypoints)
+        return straight_line_path(self.model, q0, T_goal,
+                                  lambda T, seed: ik(T, seed_q=seed, frame="ee", time_budget=budget),
+                                  lambda reason: MoveFailed(self.phase, reason), self._unreachable)
 
     def move(self, T_goal: np.ndarray, straight: bool, q_goal: np.ndarray | None = None,
              check: Callable[[], str | None] | None = None) -> None:
@@ -148,8 +139,10 @@ class ArmMover:
         from robocfg.motion.minjerk_path import MinJerkPath
 
         q0 = self.arm.joint_positions()
+        path = None
         if straight:
-            W = self.straight_waypoints(q0, T_goal)
+            W, spline = self.straight_path(q0, T_goal)
+            path = (W, spline)
         else:
             if q_goal is None:
                 q_goal = self.solve(T_goal, q0)
@@ -162,7 +155,7 @@ class ArmMover:
                         pass
             W = np.asarray([q0, q_goal])
         if np.max(np.abs(W[-1] - W[0])) >= 1e-6:
-            traj = MinJerkPath(W, self.limits)
+            traj = MinJerkPath(W, self.limits, path=path)
             if self.max_acceleration is not None:
                 traj.duration *= self._stretch(traj, self.max_acceleration)
             if self.timeout is not None and traj.duration > self.timeout:

@@ -40,6 +40,7 @@ if TYPE_CHECKING:
     from robocfg.planning.checker import CollisionChecker
     from robocfg.sim.world import World
 
+CHECK_STEP = 0.03  # m between the configurations checked along the line up (on the path played)
 WALL_MARGIN = 0.01  # m the open hand and the arm keep from a bin's walls (the planner's margin)
 # turns (deg) tried, nearest first; a parallel gripper turned by 180° is the same hand
 TURNS_DEG = (0.0, 15.0, -15.0, 30.0, -30.0, 45.0, -45.0, 60.0, -60.0, 75.0, -75.0, 90.0)
@@ -129,9 +130,11 @@ class BinWalls:
         T_top[2, 3] += top
         try:
             q = mover.solve(T_place, q0)
-            line = mover.straight_waypoints(q, T_top)
+            _, path = mover.straight_path(q, T_top)
         except MoveFailed as exc:
             return exc.reason
+        # the played path at evenly spaced parameters: about every CHECK_STEP of the line
+        line = path(np.linspace(0.0, 1.0, max(2, math.ceil(top / CHECK_STEP) + 1)))
         for qi in line:
             for checker in (self.checker, self.objects):
                 if checker is not None and not checker.is_valid(qi):

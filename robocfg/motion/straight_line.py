@@ -1,0 +1,210 @@
+"""Straight EE lines in joint space with few IK solves: adaptive subdivision checked by FK.
+
+A straight move goes from FK(q0) to ``T_goal`` (world_T_ee, m) along the segment between their
+positions, with the goal's orientation. Instead of an IK solve every few centimetres, the line
+is cut into a first guess of ``FIRST_PIECE`` m pieces: IK at the line's end (seeded from q0),
+then at the inner cuts (seeded by the joints interpolated between q0 and that answer). The joint
+path that will actually be played — :func:`robocfg.motion.minjerk_path.joint_path` through the
+waypoints, the spline ``MinJerkPath`` times — is then sampled (every ``SAMPLE_STEP`` m of line,
+at least ``MIN_SAMPLES`` inside each piece) and its EE checked by FK (pinocchio, one batch):
+within ``POSITION_TOLERANCE`` m of the segment and ``ANGLE_TOLERANCE`` rad of the goal's
+orientation. A piece that fails, or whose joints move more than ``MAX_JOINT_JUMP`` rad (a branch
+flip), gets an IK solve at its middle (seeded by its interpolated joints) and the path is checked
+again, down to pieces of ``MIN_PIECE`` m.
+
+The first point: FK(q0)'s orientation may differ from the goal's (a move converges within its
+tolerance). As before (every waypoint had the goal's orientation, the first one ``CARTESIAN_STEP``
+m along), the orientation may turn from FK(q0)'s to the goal's within the first ``CARTESIAN_STEP``
+m: the angle allowed there shrinks linearly from that difference (+ the tolerance) to the tolerance.
+When the difference is more than ``ANGLE_TOLERANCE``, the point ``CARTESIAN_STEP`` m along is
+solved first, from q0, and is a cut of the first guess (the rest is cut from it); a joint jump of
+more than ``MAX_JOINT_JUMP`` there fails the line at once, as the old way did at its first point
+(``move(straight=False)`` asks for a line when the direct answer travels far, often after a turn).
+
+A piece still failing at ``MIN_PIECE`` (e.g. the end's IK answer was on another branch than q0's),
+or a first-guess pose IK cannot reach (the old way names the first such point along the line),
+sends the line to the old way once — IK every ``CARTESIAN_STEP`` m, each seeded from the previous
+answer — and that path is checked and subdivided the same way. Failing again: "no continuous IK
+along the straight line", with the joint jump (> ``MAX_JOINT_JUMP``) or the EE's distance from the
+line (> ``GIVE_UP_DISTANCE`` m) and where; a pose IK cannot reach: "unreachable at X % of the
+straight line". Between ``POSITION_TOLERANCE`` and ``GIVE_UP_DISTANCE`` a ``MIN_PIECE`` piece is
+kept (what the old way kept, unchecked, at ``CARTESIAN_STEP``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from itertools import pairwise
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from robocfg.geometry import rotation_angle
+from robocfg.motion.minjerk_path import JointSpline, joint_path, joint_path_knots
+
+if TYPE_CHECKING:
+    from robocfg.kinematics.ik.result import IKResult
+    from robocfg.kinematics.model import KinematicModel
+
+CARTESIAN_STEP = 0.03  # m: the old way's IK spacing, and where the orientation must be the goal's
+MAX_JOINT_JUMP = 0.5  # rad between consecutive waypoints of a line (more: a branch flip)
+FIRST_PIECE = 0.045  # m: the first guess's longest piece (a 12 cm approach: three)
+MIN_PIECE = 0.005  # m: pieces are not cut below this
+SAMPLE_STEP = 0.02  # m of line between FK samples (at least MIN_SAMPLES inside each piece)
+MIN_SAMPLES = 3
+POSITION_TOLERANCE = 5e-5  # m: the played path's EE from the segment
+ANGLE_TOLERANCE = math.radians(0.01)  # rad: its orientation from the goal's (past the first CARTESIAN_STEP)
+GIVE_UP_DISTANCE = 1e-3  # m: a MIN_PIECE piece further than this from the line breaks the line
+
+Solve = Callable[[np.ndarray, np.ndarray], "IKResult"]  # (world_T_ee, seed) -> IK answer
+Fail = Callable[[str], Exception]  # reason -> the error to raise
+Unreachable = Callable[["IKResult", str], Exception]  # (answer, " at X % of the straight line") -> error
+
+
+class _Line:
+    """The segment from FK(q0) to ``T_goal``, IK on it, and the FK check of a joint path."""
+
+    def __init__(self, model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray, ik: Solve):
+        T0 = model.fk(q0, "ee")
+        self.model, self.ik = model, ik
+        self.T_goal = np.array(T_goal, dtype=float)
+        self.p0, self.p1 = T0[:3, 3].copy(), self.T_goal[:3, 3].copy()
+        self.length = float(np.linalg.norm(self.p1 - self.p0))
+        self.u = (self.p1 - self.p0) / self.length if self.length > 0 else np.zeros(3)
+        self.turn0 = rotation_angle(T0[:3, :3], self.T_goal[:3, :3])  # rad to turn in the first CARTESIAN_STEP
+
+    def solve(self, s: float, seed: np.ndarray) -> np.ndarray:
+        """IK of the line's pose at fraction ``s`` from ``seed``; raises _Unreachable."""
+        T = self.T_goal.copy()
+        (x0, y0, z0), (x1, y1, z1) = self.p0.tolist(), self.p1.tolist()
+        T[:3, 3] = ((1 - s) * x0 + s * x1, (1 - s) * y0 + s * y1, (1 - s) * z0 + s * z1)
+        res = self.ik(T, seed)
+        if not res.converged:
+            raise _Unreachable(res, s)
+        return res.q
+
+    def errors(self, path: JointSpline, knots: np.ndarray, S: list[float]) -> tuple[np.ndarray, np.ndarray]:
+        """Per piece i (between knots i and i+1 of ``path``, line fractions S[i]..S[i+1]): the
+        largest distance (m) of the sampled EE from the segment, and whether a sample's
+        orientation is further from the goal's than allowed there (bool)."""
+        samples: list[float] = []
+        starts: list[int] = []
+        for (a, b), ka, kb in zip(pairwise(S), knots[:-1].tolist(), knots[1:].tolist(), strict=True):
+            m = max(MIN_SAMPLES, math.ceil(self.length * (b - a) / SAMPLE_STEP))
+            starts.append(len(samples))
+            samples += [ka + (kb - ka) * j / (m + 1) for j in range(1, m + 1)]
+        P, R = self.model.fk_poses(path(np.array(samples)), "ee")
+        v = P - self.p0
+        proj = v @ self.u
+        along = np.minimum(np.maximum(proj, 0.0), self.length)
+        off = v - along[:, None] * self.u
+        dist = np.sqrt(np.einsum("ij,ij->i", off, off))
+        # cos of the angle to the goal's orientation, (trace(goal_R_ee) - 1) / 2, against the allowed angle's
+        cos = (np.einsum("nij,ij->n", R, self.T_goal[:3, :3]) - 1.0) / 2.0
+        allowed = ANGLE_TOLERANCE + self.turn0 * np.maximum(1.0 - along / CARTESIAN_STEP, 0.0)
+        turned = cos < np.cos(np.minimum(allowed, math.pi))
+        return np.maximum.reduceat(dist, starts), np.logical_or.reduceat(turned, starts)
+
+
+class _Unreachable(Exception):
+    """IK did not converge at line fraction ``s``: ``res`` is its best answer."""
+
+    def __init__(self, res: IKResult, s: float):
+        super().__init__(s)
+        self.res, self.s = res, s
+
+
+class _Broken(Exception):
+    """A ``MIN_PIECE`` piece that cannot be accepted: ``reason`` for the failure message."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+        self.reason = reason
+
+
+def straight_line_path(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray, ik: Solve,
+                       fail: Fail, unreachable: Unreachable) -> tuple[np.ndarray, JointSpline]:
+    """Joint waypoints (k, n) from ``q0`` to an IK answer of ``T_goal`` whose played path (the
+    second item: :func:`joint_path` of them, for ``MinJerkPath(path=...)``) keeps the EE on the
+    straight line (see the module docstring); raises ``fail(reason)`` or ``unreachable``."""
+    q0 = np.asarray(q0, dtype=float)
+    line = _Line(model, q0, T_goal, ik)
+    try:
+        try:
+            return _first_guess(line, q0, fail)
+        except (_Broken, _Unreachable):  # the old way: each point from the last (where it breaks, first)
+            n = max(1, math.ceil(line.length / CARTESIAN_STEP - 1e-9))
+            S = np.linspace(0.0, 1.0, n + 1).tolist()
+            Q = [q0]
+            for s in S[1:]:
+                Q.append(line.solve(s, Q[-1]))
+            return _refine(line, S, Q)
+    except _Unreachable as exc:
+        raise unreachable(exc.res, f" at {exc.s:.0%} of the straight line") from None
+    except _Broken as exc:
+        raise fail(f"no continuous IK along the straight line ({exc.reason})") from None
+
+
+def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, JointSpline]:
+    """The line from few IK solves (module docstring), refined; raises _Broken or _Unreachable
+    for the old way to try, ``fail`` where the old way would have failed the same."""
+    if line.length < MIN_PIECE:  # too short to cut: the goal's answer, checked for a jump
+        q1 = line.solve(1.0, q0)
+        jump = float(np.max(np.abs(q1 - q0)))
+        if jump > MAX_JOINT_JUMP:
+            raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at 100%)")
+        return np.asarray([q0, q1]), joint_path(np.asarray([q0, q1]))[1]
+    S, Q = [0.0], [q0]
+    if line.turn0 > ANGLE_TOLERANCE:  # the orientation turns within the first CARTESIAN_STEP: that point first, from q0
+        s1 = min(1.0, CARTESIAN_STEP / line.length)
+        q = line.solve(s1, q0)
+        jump = float(np.max(np.abs(q - q0)))
+        if jump > MAX_JOINT_JUMP:  # as the old way fails at its first point
+            raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at {s1:.0%})")
+        S.append(s1)
+        Q.append(q)
+    if S[-1] < 1.0:  # the rest: IK at its end from the last answer, then at the cuts between, seeded by interpolation
+        a, qa = S[-1], Q[-1]
+        n = max(1, math.ceil(line.length * (1.0 - a) / FIRST_PIECE - 1e-9))
+        cuts = np.linspace(a, 1.0, n + 1)[1:].tolist()
+        q1 = line.solve(1.0, qa)
+        for s in cuts[:-1]:
+            Q.append(line.solve(s, qa + (s - a) / (1.0 - a) * (q1 - qa)))
+        S += cuts
+        Q.append(q1)
+    return _refine(line, S, Q)
+
+
+def _refine(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarray, JointSpline]:
+    """Cut the failing pieces of the path through ``Q`` (at line fractions ``S``) until every
+    piece passes or is ``MIN_PIECE`` short; raises _Broken for a short piece that breaks the line."""
+    kept: set[tuple[float, float]] = set()  # MIN_PIECE pieces within GIVE_UP_DISTANCE, accepted
+    while True:
+        W = np.asarray(Q)
+        W_kept, path, knots = joint_path_knots(W)
+        if len(W_kept) != len(W):  # an answer repeated (the line does not move the joints): nothing to check
+            return W, path
+        dist, turned = line.errors(path, knots, S)
+        jumps = np.abs(np.diff(W, axis=0)).max(axis=1)
+        new_S, new_Q, cut = [S[0]], [Q[0]], False
+        for i in range(len(S) - 1):
+            a, b = S[i], S[i + 1]
+            bad = dist[i] > POSITION_TOLERANCE or turned[i] or jumps[i] > MAX_JOINT_JUMP
+            if bad and (a, b) not in kept:
+                if line.length * (b - a) >= 2 * MIN_PIECE:
+                    m = 0.5 * (a + b)
+                    new_S.append(m)
+                    new_Q.append(line.solve(m, 0.5 * (Q[i] + Q[i + 1])))
+                    cut = True
+                elif jumps[i] > MAX_JOINT_JUMP:
+                    raise _Broken(f"a joint jumps {jumps[i]:.2f} rad at {b:.0%}")
+                elif dist[i] > GIVE_UP_DISTANCE:
+                    raise _Broken(f"the EE leaves the line by {dist[i] * 1000:.1f} mm at {b:.0%}")
+                else:
+                    kept.add((a, b))
+            new_S.append(b)
+            new_Q.append(Q[i + 1])
+        if not cut:
+            return W, path
+        S, Q = new_S, new_Q
