@@ -72,6 +72,26 @@ def test_write_json_is_atomic_under_two_writers_and_a_reader(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["r.json"]  # no temporary file left behind
 
 
+def test_write_json_writes_non_finite_numbers_as_null(tmp_path):
+    # a diverged body's pose is NaN: the report must stay JSON that strict readers accept
+    import dataclasses
+
+    import numpy as np
+
+    @dataclasses.dataclass
+    class Row:
+        final: list[float]
+        tilt: float
+
+    target = tmp_path / "r.json"
+    write_json(target, {"episodes": [Row([float("nan"), 0.5, float("inf")], np.float32("nan"))],
+                        "k": (1, -float("inf")), "ok": np.bool_(True), "n": np.int64(3)})
+    text = target.read_text()
+    assert "NaN" not in text and "Infinity" not in text
+    doc = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-standard JSON token {c}"))
+    assert doc == {"episodes": [{"final": [None, 0.5, None], "tilt": None}], "k": [1, None], "ok": True, "n": 3}
+
+
 def test_sigint_writes_the_finished_episodes_marked_interrupted(tmp_path):
     """SIGINT during episode 0 of 3: episode 0 finishes, the report holds it (identical to the same
     episode of an uninterrupted run), says interrupted, and the exit code is 130."""

@@ -102,7 +102,11 @@ def write_json(path: Path | None, payload: Any) -> None:
 
     ``-`` writes to standard output. A file is written atomically: a temporary file in the same
     folder, flushed, then renamed over ``path``, so a reader (or a second writer, or a crash) never
-    sees half a report and an older report is either kept whole or replaced whole."""
+    sees half a report and an older report is either kept whole or replaced whole.
+
+    JSON has no NaN or infinity (``json.dumps`` would write the non-standard tokens ``NaN`` and
+    ``Infinity``, which strict readers reject): a non-finite number, such as the pose of a body
+    whose physics diverged, is written as ``null``."""
     import sys
     import tempfile
 
@@ -110,7 +114,7 @@ def write_json(path: Path | None, payload: Any) -> None:
         return
     if hasattr(payload, "model_dump"):
         payload = payload.model_dump(mode="json")
-    text = json.dumps(payload, indent=2, sort_keys=False, default=_default) + "\n"
+    text = json.dumps(_finite(payload), indent=2, sort_keys=False, default=_default, allow_nan=False) + "\n"
     if path == STDOUT:
         sys.stdout.write(text)
         sys.stdout.flush()
@@ -129,6 +133,20 @@ def write_json(path: Path | None, payload: Any) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _finite(o: Any) -> Any:
+    """``o`` with every non-finite float in its dicts, lists and tuples replaced by None (the
+    objects ``_default`` converts are converted first, so their floats are reached too)."""
+    if isinstance(o, float):
+        return o if o - o == 0.0 else None  # inf - inf and nan - nan are nan
+    if isinstance(o, dict):
+        return {k: _finite(v) for k, v in o.items()}
+    if isinstance(o, list | tuple):
+        return [_finite(v) for v in o]
+    if isinstance(o, str | int | bool) or o is None:
+        return o
+    return _finite(_default(o))
 
 
 def _default(o: Any) -> Any:
