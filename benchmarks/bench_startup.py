@@ -18,7 +18,8 @@ warm-up run (file cache). Rows:
   just before the spawn: *imports* (robocfg.engine and the task loader imported), *task* (loaded
   and checked), *world* (the world built: the **fixed start** a process pays before its first
   episode), *episode 0* done, and *episode 1* alone (what each further episode costs). The child
-  runs with one math-library thread as those workers do (``OPENBLAS_NUM_THREADS``,
+  pauses the garbage collector first as those workers do (:mod:`robocfg.collector`; the engine
+  resumes it once the world is built) and runs with one math-library thread as they do (``OPENBLAS_NUM_THREADS``,
   ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS`` = 1, unless set in this environment: a pool's fork
   server sets them, Ray sets ``OMP_NUM_THREADS``); ``--math-threads default`` leaves the
   libraries their default (a thread per core each for numpy's and scipy's OpenBLAS).
@@ -68,6 +69,8 @@ import json, time
 marks = {}
 def mark(name):
     marks[name] = (time.time(), time.process_time())
+from robocfg import collector
+collector.pause()  # as a pool worker or Ray actor does first (robocfg.collector)
 from robocfg.checks.task import load_task
 from robocfg.config import catalog
 from robocfg.engine import RunOptions, open_session

@@ -89,10 +89,12 @@ app.add_typer(dataset.dataset_app, name="dataset")
 
 def main() -> None:
     """Console-script entry point."""
+    from robocfg import collector
     from robocfg.cli.common import debug_enabled, set_debug
     from robocfg.cli.errors import describe
     from robocfg.cli.process import single_math_thread, skip_final_collection
 
+    collector.pause()  # no collections during the start: resumed once a world is built (robocfg.collector)
     single_math_thread()  # before numpy loads (robocfg.cli.process)
     skip_final_collection()  # before any command registers its own atexit handlers
     set_debug("--debug" in sys.argv[1:])
@@ -116,6 +118,8 @@ def main() -> None:
         code, message = describe(exc)
         print(message, file=sys.stderr)
         sys.exit(code)
+    finally:
+        collector.restore()  # a program or a test calling main() gets its thresholds back
 
 
 def _cli_exception_types() -> tuple[tuple[type, ...], tuple[type, ...]]:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar
 
 import numpy as np
 
+from robocfg import collector
 from robocfg.engine.options import EpisodeOutcome, FrameRecorder, RunOptions
 from robocfg.engine.runner import RunOutput, TaskRunner
 
@@ -100,6 +101,7 @@ class EpisodeSession(ABC, Generic[RecordT]):
         except BaseException:
             self.world.close()
             raise
+        collector.resume()  # the process's start is over (robocfg.collector; nothing unless it paused)
 
     def draws(self) -> bool:
         """Whether anything draws this session's world, so its robots need their visual meshes:

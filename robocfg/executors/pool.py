@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from typing import Any
 
+from robocfg import collector
 from robocfg.errors import RobocfgError
 from robocfg.executors.outcome import Execution, LostEpisodes
 from robocfg.executors.session import (
@@ -51,6 +52,7 @@ def _worker_main(conn: Connection, recipe: Recipe, setup: WorkerSetup, index: in
     """Worker ``index``: set up its process, open the recipe once, then run the batches it is sent
     (and make the report when asked) until it is sent None."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    collector.pause()  # until its world is built (robocfg.collector)
     opening = time.time()
     try:
         set_up = apply(setup, index)

@@ -73,8 +73,10 @@ class _Actor:
     """A Ray actor holding one session (opened from a recipe; reopened for another by ``open``)."""
 
     def __init__(self, recipe: Recipe):
+        from robocfg import collector
         from robocfg.executors.worker_setup import follow_omp_threads
 
+        collector.pause()  # until its world is built (robocfg.collector)
         follow_omp_threads()  # one math-library thread, as a pool worker runs (worker_setup)
         self.session: Any = None
         self.open(recipe)
