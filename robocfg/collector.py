@@ -15,7 +15,8 @@ is built and its snapshot taken, moves every object alive then into the permanen
 (:func:`gc.freeze`: later full collections do not traverse the start-up's objects again, and the
 first collection after the start does not traverse all of them as young objects) and restores
 the thresholds. Reference cycles that became garbage during the start stay allocated (the
-start-up makes few of them).
+start-up makes few of them). Nothing is frozen where a nanobind extension is loaded by then (it
+would report the frozen objects as leaked at exit) or where the process froze objects itself.
 
 Only processes robocfg owns pause: the ``robocfg`` command (``robocfg.cli.app.main``, which
 puts the thresholds back with :func:`restore` as it returns, for a program or a test calling
@@ -27,10 +28,12 @@ where :func:`pause` was not called.
 from __future__ import annotations
 
 import gc
+import sys
 
 START_THRESHOLD = 100_000  # net new container objects between generation-0 collections during the start
 
 _saved: tuple[int, int, int] | None = None  # the thresholds pause() replaced
+_froze = False  # resume() froze the objects alive then (restore() thaws them)
 
 
 def pause() -> None:
@@ -43,22 +46,44 @@ def pause() -> None:
 
 
 def resume() -> None:
-    """After :func:`pause`: freeze the objects alive now (:func:`gc.freeze`) and restore the
-    thresholds; nothing otherwise."""
-    global _saved
+    """After :func:`pause`: freeze the objects alive now (:func:`gc.freeze`; not when something
+    froze objects before, nor when a nanobind extension is loaded, see :func:`nanobind_loaded`)
+    and restore the thresholds; nothing otherwise."""
+    global _saved, _froze
     if _saved is not None:
-        gc.freeze()
+        if gc.get_freeze_count() == 0 and not nanobind_loaded():
+            gc.freeze()
+            _froze = True
         gc.set_threshold(*_saved)
         _saved = None
 
 
 def restore() -> None:
-    """After :func:`pause`: the thresholds back, nothing frozen (the command's end, for a program
-    or a test that calls ``main()`` in its own process); nothing otherwise."""
-    global _saved
+    """The collector as before :func:`pause`: the thresholds back, the objects :func:`resume` froze
+    thawed (:func:`gc.unfreeze`). The command's end calls it, for a program or a test that calls
+    ``main()`` in its own process; the command's exit then does what it did
+    (``robocfg.cli.process``)."""
+    global _saved, _froze
     if _saved is not None:
         gc.set_threshold(*_saved)
         _saved = None
+    if _froze:
+        gc.unfreeze()
+        _froze = False
+
+
+def nanobind_loaded() -> bool:
+    """Whether a loaded extension module defines a nanobind type (its metaclass is nanobind's).
+    nanobind prints every object of its own still alive at exit as a "leak" on stderr: frozen
+    objects are, as are those the final collection would have freed (OMPL's bindings, which the
+    planned pick-place mode uses; ruckig; trimesh's helpers)."""
+    for module in list(sys.modules.values()):
+        if (getattr(module, "__file__", None) or "").endswith(".py"):
+            continue  # Python source: its classes are Python's
+        for value in list(getattr(module, "__dict__", {}).values()):
+            if isinstance(value, type) and type(value).__module__ == "nanobind":
+                return True
+    return False
 
 
 def paused() -> bool:

@@ -36,6 +36,7 @@ import gc
 import os
 import sys
 
+from robocfg.collector import nanobind_loaded
 from robocfg.executors.worker_setup import MATH_THREAD_VARIABLES
 
 _registered = False
@@ -64,12 +65,3 @@ def _freeze() -> None:
         gc.freeze()
 
 
-def nanobind_loaded() -> bool:
-    """Whether a loaded extension module defines a nanobind type (its metaclass is nanobind's)."""
-    for module in list(sys.modules.values()):
-        if (getattr(module, "__file__", None) or "").endswith(".py"):
-            continue  # Python source: its classes are Python's
-        for value in list(getattr(module, "__dict__", {}).values()):
-            if isinstance(value, type) and type(value).__module__ == "nanobind":
-                return True
-    return False
