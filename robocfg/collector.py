@@ -1,6 +1,6 @@
 """The garbage collector during a process's start-up: no collections until the world is built.
 
-A robocfg process's start (the imports, the task's validators, the world) creates ≈ 70 000
+A robocfg process's start (the imports, the task's validators, the world) creates ≈ 80 000
 container objects — modules, classes, functions, pydantic schemas — that live as long as the
 process. CPython's collector counts them as they are made and runs a generation-0 collection every
 700 net new ones and a generation-1 every tenth of those: ≈ 100 collections before a pick-place
