@@ -96,9 +96,14 @@ class CubicSpline:
         i = np.minimum(np.maximum(np.searchsorted(self.x, flat, side="right") - 1, 0), len(self.x) - 2)
         s = flat - self.x[i]
         coefs = c.take(i, axis=2)  # (order, n, points): coefs[order - kp - 1] multiplies s**kp
-        powers: list[np.ndarray | None] = [None]  # s**m built as (s*s)*s...; None stands for scipy's exact 1.0
         nan = np.isnan(flat)
         has_nan = bool(nan.any())
+        if nus == (0, 1) and order == 4:  # what a played move asks: both sums at once
+            both = _values_and_slopes(coefs, s)
+            if has_nan:
+                both[:, :, nan] = np.nan
+            return [both[0], both[1]]
+        powers: list[np.ndarray | None] = [None]  # s**m built as (s*s)*s...; None stands for scipy's exact 1.0
         out = []
         tmp: np.ndarray | None = None
         for nu in nus:
@@ -138,6 +143,27 @@ class CubicSpline:
                 res[:, nan] = np.nan  # scipy: NaN in, NaN out (every derivative)
             out.append(res)
         return out
+
+
+_SLOPE_FACTORS = np.array([1.0, 2.0])[:, None, None]  # (value, slope) prefactors of the s term ...
+_SLOPE_FACTORS_2 = np.array([1.0, 3.0])[:, None, None]  # ... and of the s² term (x * 1.0 is x, bit for bit)
+
+
+def _values_and_slopes(coefs: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``derivatives_by_column``'s loop for nus (0, 1) of a cubic, the two sums stacked (2, n, N):
+    values ``((c3 + 0.0) + c2·s) + c1·s²) + c0·s³`` and slopes ``((c2 + 0.0) + (c1·s)·2) + (c0·s²)·3``
+    (``coefs`` = [c0, c1, c2, c3] gathered at the points, highest power first, ``s`` the local
+    coordinate): each term and each sum the same operations in the same order as the loop."""
+    out = coefs[2:4][::-1] + 0.0  # [c3, c2] + 0.0
+    term = coefs[1:3][::-1] * s  # [c2·s, c1·s]
+    term *= _SLOPE_FACTORS
+    out += term
+    s2 = s * s
+    np.multiply(coefs[0:2][::-1], s2, out=term)  # [c1·s², c0·s²]
+    term *= _SLOPE_FACTORS_2
+    out += term
+    out[0] += coefs[0] * (s2 * s)
+    return out
 
 
 def _solve_tridiagonal(A: np.ndarray, b: np.ndarray) -> np.ndarray:

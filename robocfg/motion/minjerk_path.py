@@ -40,6 +40,22 @@ class _Segment:
         """``[self(s, nu) for nu in nus]`` (the interface of :meth:`CubicSpline.derivatives`)."""
         return [self(s, nu) for nu in nus]
 
+    def derivatives_by_column(self, s, nus: tuple[int, ...]) -> list[np.ndarray]:
+        """``[self(s, nu).T for nu in nus]`` for 1-D ``s``: (n, len(s)) arrays, the same values
+        (the interface of :meth:`CubicSpline.derivatives_by_column`)."""
+        s = np.asarray(s, dtype=float)
+        if s.ndim != 1:
+            raise ValueError("derivatives_by_column: 1-D s only")
+        out = []
+        for nu in nus:
+            if nu == 0:
+                out.append(self.delta[:, None] * s + self.start[:, None])
+            elif nu == 1:
+                out.append(np.repeat(self.delta[:, None], len(s), axis=1))
+            else:
+                out.append(np.zeros((len(self.delta), len(s))))
+        return out
+
 
 class _Cubic:
     """The one polynomial of degree ≤ 3 through three or four waypoints at knots ``x`` (0 … 1):
@@ -156,12 +172,12 @@ class MinJerkPath(Trajectory):
         self.duration = float(max(t_vel, t_acc, min_duration))
 
     def positions_velocities(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """``evaluate(t)``'s (q, qd) by the same arithmetic, without the accelerations. A spline's
-        are evaluated a joint at a time along the times (:meth:`CubicSpline.derivatives_by_column`)
-        and come back as the transposes of those (n, N) arrays (the same values; not C-ordered)."""
-        tau, s = self._law(t)
-        sd = 30 * tau**2 * (1 - tau) ** 2 / self.duration
-        if isinstance(self.spline, CubicSpline) and s.ndim == 1:
+        """``evaluate(t)``'s (q, qd) by the same arithmetic, without the accelerations, evaluated a
+        joint at a time along the times (:meth:`CubicSpline.derivatives_by_column`): they come
+        back as the transposes of those (n, N) arrays (the same values; not C-ordered)."""
+        tau, tau2, s = self._law(t)
+        sd = 30 * tau2 * (1 - tau) ** 2 / self.duration
+        if s.ndim == 1:
             q, d1 = self.spline.derivatives_by_column(s, (0, 1))
             d1 *= sd  # d1 is new: scaled in place, each element as d1 * sd[:, None] scales it
             return q.T, d1.T
@@ -170,17 +186,18 @@ class MinJerkPath(Trajectory):
 
     def positions(self, t) -> np.ndarray:
         """``evaluate(t)``'s q by the same arithmetic (C-ordered), without the derivatives."""
-        _, s = self._law(t)
-        if isinstance(self.spline, CubicSpline) and s.ndim == 1:
+        _, _, s = self._law(t)
+        if s.ndim == 1:
             return np.ascontiguousarray(self.spline.derivatives_by_column(s, (0,))[0].T)
         return self.spline.derivatives(s, (0,))[0]
 
-    def _law(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """(τ, s) of the min-jerk law at times ``t`` (s; clipped to [0, duration]), as ``_eval``
-        computes them."""
+    def _law(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(τ, τ², s) of the min-jerk law at times ``t`` (s; clipped to [0, duration]), as
+        ``_eval`` computes them (τ**2 is τ squared, once)."""
         tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
         tau = np.clip(tt / self.duration, 0.0, 1.0)
-        return tau, tau**3 * (10 - 15 * tau + 6 * tau**2)
+        tau2 = tau**2
+        return tau, tau2, tau**3 * (10 - 15 * tau + 6 * tau2)
 
     def _eval(self, t):
         T = self.duration
