@@ -78,6 +78,7 @@ class SceneQueries:
         ray, aabb, c = p.rayTest, p.getAABB, self.client
         found = 0
         seen: set[tuple[int, int]] = set()
+        boxes: dict[tuple[int, int], tuple] = {}
         s, step, last = [ax, ay, az], 1e-4, (-1, -1)
         for _ in range(8 * max_hits):
             h = ray(s, to, physicsClientId=c)[0]
@@ -93,7 +94,10 @@ class SceneQueries:
                 yield RayHit(key[0], (hx, hy, hz))
                 if found >= max_hits:
                     break
-            lo, hi = aabb(h[0], h[1], physicsClientId=c)
+            box = boxes.get(key)
+            if box is None:  # nothing moves during a walk: a link's box is read once
+                box = boxes[key] = aabb(h[0], h[1], physicsClientId=c)
+            lo, hi = box
             exits = [((hi[k] if d[k] > 0 else lo[k]) - hit[k]) / d[k] for k in axes]
             m = min(step, max(min(exits), 0.0) + 1e-4)
             s = [hx + m * dx, hy + m * dy, hz + m * dz]
