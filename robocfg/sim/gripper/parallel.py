@@ -105,7 +105,8 @@ class ParallelGripper(Gripper):
 
     def set_fraction(self, s: float) -> None:
         """Command an opening fraction: 0 = ``closed`` joint positions, 1 = ``open``."""
-        self._goal = float(np.clip(s, 0.0, 1.0))
+        s = float(s)
+        self._goal = s if 0.0 <= s <= 1.0 else float(np.clip(s, 0.0, 1.0))  # (np.clip keeps an in-range value as it is)
         if self.rate is None:
             self._cmd = self._goal
             self._send()
@@ -139,7 +140,10 @@ class ParallelGripper(Gripper):
 
     def _send(self) -> None:
         kp, kd = self._gains
-        for n, q in zip(self.joints, self._q(self._cmd), strict=True):
+        s = self._cmd
+        # _q(s) in Python floats where fraction() has the terms: q_closed + s·(q_open − q_closed), per joint
+        targets = self._q(s).tolist() if self._fraction_terms is None else [c + s * span for c, span in self._fraction_terms]
+        for n, q in zip(self.joints, targets, strict=True):
             self.robot.set_drive(n, Drive(float(q), kp, kd, self.force, max_velocity=self.config.max_velocity))
 
     # ---- measurements ------------------------------------------------------------------------
