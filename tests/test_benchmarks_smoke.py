@@ -44,3 +44,10 @@ def test_scaling_runs_one_episode_per_pool_variant():
     usage = [r for r in rows if len(r) == 17 and "/" in r[12]]  # the per-episode usage table's rows
     assert len(usage) == 2 and [r[14] for r in usage] == ["1", str(len(os.sched_getaffinity(0)))], p.stdout
     assert "physics speed with w processes busy" in p.stdout
+
+
+def test_control_swap_runs_a_pair_against_a_checkout():
+    p = _run(["benchmarks/bench_control_swap.py", "--base", str(ROOT), "--swap", "robocfg.motion.moves:ArmMover.converge",
+              "--time", "robocfg.motion.moves:ArmMover.converge", "--episodes", "1"], timeout=600)
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr[-3000:]
+    assert "1 episode pairs" in p.stdout and "inside the --time functions" in p.stdout, p.stdout
