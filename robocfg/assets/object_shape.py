@@ -64,8 +64,14 @@ class ObjectShape:
 
     @property
     def vertices(self) -> np.ndarray:
-        """(N, 3) hull vertices of every part, body frame (m)."""
-        return np.concatenate([np.asarray(p.vertices) for p in self.parts])
+        """(N, 3) hull vertices of every part, body frame (m); gathered once per shape (read-only:
+        every pose of the object reads them)."""
+        v = self.__dict__.get("_vertices")
+        if v is None:
+            v = np.concatenate([np.asarray(p.vertices) for p in self.parts])
+            v.setflags(write=False)
+            self.__dict__["_vertices"] = v
+        return v
 
     def extents(self) -> np.ndarray:
         """Axis-aligned extents (m) in the body frame."""

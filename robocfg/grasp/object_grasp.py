@@ -56,8 +56,14 @@ class LyingObject:
     support_z: float
 
     def points(self) -> np.ndarray:
-        """Hull vertices in the world frame (m)."""
-        return self.shape.posed(self.rotation) + self.position
+        """Hull vertices in the world frame (m); computed once per lying object (read-only: the
+        grasp search reads them several times)."""
+        P = self.__dict__.get("_points")
+        if P is None:
+            P = self.shape.posed(self.rotation) + self.position
+            P.setflags(write=False)
+            self.__dict__["_points"] = P
+        return P
 
     def surface_points(self) -> np.ndarray:
         """Points spread over the surface, world frame (m): a fixed sample (same object ⇒ same

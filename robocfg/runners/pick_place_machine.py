@@ -283,8 +283,9 @@ class _StateMachine(GraspChoice):
         p = self.params
         pos, quat = self.world.body_pose(self.obj)
         err = float(np.linalg.norm(pos[:2] - self.setup.place_xy))
-        tilt = self._tilt(quat)
-        rest_z = self._support_height(self.setup.place_xy) + self.shape.below_origin(quat_to_matrix(quat))
+        R = quat_to_matrix(quat)
+        tilt = self.shape.tilt_deg(self.R0, R)  # as _tilt(quat)
+        rest_z = self._support_height(self.setup.place_xy) + self.shape.below_origin(R)
         if err > p.success_tolerance:
             raise MoveFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
         if tilt > p.max_tilt_deg:
