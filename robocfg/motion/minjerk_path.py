@@ -97,6 +97,26 @@ class _Cubic:
                 out.append(np.broadcast_to(6 * a if nu == 3 else 0 * a, s.shape[:-1] + a.shape).copy())
         return out
 
+    def derivatives_by_column(self, s, nus: tuple[int, ...]) -> list[np.ndarray]:
+        """``[path(s, nu).T for nu in nus]`` for 1-D ``s``: (n, len(s)) arrays, the same values
+        (each element the same operations as :meth:`derivatives`; the interface of
+        :meth:`CubicSpline.derivatives_by_column`)."""
+        s = np.asarray(s, dtype=float)
+        if s.ndim != 1:
+            raise ValueError("derivatives_by_column: 1-D s only")
+        a, b, c, d = (v[:, None] for v in self.c[:, 0])
+        out = []
+        for nu in nus:
+            if nu == 0:
+                out.append(((a * s + b) * s + c) * s + d)
+            elif nu == 1:
+                out.append((3 * a * s + 2 * b) * s + c)
+            elif nu == 2:
+                out.append(6 * a * s + 2 * b)
+            else:
+                out.append(np.broadcast_to(6 * a if nu == 3 else 0 * a, (len(a), len(s))).copy())
+        return out
+
 
 JointSpline = _Segment | _Cubic | CubicSpline
 
