@@ -19,7 +19,8 @@ warm-up run (file cache). Rows:
   and checked), *world* (the world built: the **fixed start** a process pays before its first
   episode), *episode 0* done, and *episode 1* alone (what each further episode costs). The child
   pauses the garbage collector first as those workers do (:mod:`robocfg.collector`; the engine
-  resumes it once the world is built) and runs with one math-library thread as they do (``OPENBLAS_NUM_THREADS``,
+  resumes it once the world is built; a checkout without that module, e.g. an older ``--root``,
+  runs with its collector as it was) and runs with one math-library thread as they do (``OPENBLAS_NUM_THREADS``,
   ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS`` = 1, unless set in this environment: a pool's fork
   server sets them, Ray sets ``OMP_NUM_THREADS``); ``--math-threads default`` leaves the
   libraries their default (a thread per core each for numpy's and scipy's OpenBLAS).
@@ -69,8 +70,12 @@ import json, time
 marks = {}
 def mark(name):
     marks[name] = (time.time(), time.process_time())
-from robocfg import collector
-collector.pause()  # as a pool worker or Ray actor does first (robocfg.collector)
+try:
+    from robocfg import collector
+except ImportError:  # a checkout from before robocfg.collector (--root/--against an older one)
+    pass
+else:
+    collector.pause()  # as a pool worker or Ray actor does first (robocfg.collector)
 from robocfg.checks.task import load_task
 from robocfg.config import catalog
 from robocfg.engine import RunOptions, open_session
