@@ -40,7 +40,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robocfg.geometry import rotation_angle
 from robocfg.motion.minjerk_path import JointSpline, joint_path, joint_path_knots
 
 if TYPE_CHECKING:
@@ -66,18 +65,24 @@ class _Line:
     """The segment from FK(q0) to ``T_goal``, IK on it, and the FK check of a joint path."""
 
     def __init__(self, model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray, ik: Solve):
-        T0 = model.fk(q0, "ee")
+        # Python floats for the line's few numbers and the per-sample checks of ``errors``: these
+        # run once or twice per line, right after hundreds of physics steps, where each small
+        # numpy call costs several times its warm cost
+        T0 = model.fk(q0, "ee").tolist()
         self.model, self.ik = model, ik
         self.T_goal = np.array(T_goal, dtype=float)
-        self.p0, self.p1 = T0[:3, 3].copy(), self.T_goal[:3, 3].copy()
-        self.length = float(np.linalg.norm(self.p1 - self.p0))
-        self.u = (self.p1 - self.p0) / self.length if self.length > 0 else np.zeros(3)
-        self.turn0 = rotation_angle(T0[:3, :3], self.T_goal[:3, :3])  # rad to turn in the first CARTESIAN_STEP
+        goal = self.T_goal.tolist()
+        self.p0, self.p1 = [r[3] for r in T0[:3]], [r[3] for r in goal[:3]]
+        d = [b - a for a, b in zip(self.p0, self.p1, strict=True)]
+        self.length = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        self.u = [v / self.length for v in d] if self.length > 0 else [0.0, 0.0, 0.0]
+        self.R_goal = [v for r in goal[:3] for v in r[:3]]  # row-major 3x3
+        self.turn0 = _angle([v for r in T0[:3] for v in r[:3]], self.R_goal)  # rad to turn in the first CARTESIAN_STEP
 
     def solve(self, s: float, seed: np.ndarray) -> np.ndarray:
         """IK of the line's pose at fraction ``s`` from ``seed``; raises _Unreachable."""
         T = self.T_goal.copy()
-        (x0, y0, z0), (x1, y1, z1) = self.p0.tolist(), self.p1.tolist()
+        (x0, y0, z0), (x1, y1, z1) = self.p0, self.p1
         T[:3, 3] = ((1 - s) * x0 + s * x1, (1 - s) * y0 + s * y1, (1 - s) * z0 + s * z1)
         res = self.ik(T, seed)
         if not res.converged:
@@ -95,16 +100,29 @@ class _Line:
             starts.append(len(samples))
             samples += [ka + (kb - ka) * j / (m + 1) for j in range(1, m + 1)]
         P, R = self.model.fk_poses(path(np.array(samples)), "ee")
-        v = P - self.p0
-        proj = v @ self.u
-        along = np.minimum(np.maximum(proj, 0.0), self.length)
-        off = v - along[:, None] * self.u
-        dist = np.sqrt(np.einsum("ij,ij->i", off, off))
-        # cos of the angle to the goal's orientation, (trace(goal_R_ee) - 1) / 2, against the allowed angle's
-        cos = (np.einsum("nij,ij->n", R, self.T_goal[:3, :3]) - 1.0) / 2.0
-        allowed = ANGLE_TOLERANCE + self.turn0 * np.maximum(1.0 - along / CARTESIAN_STEP, 0.0)
-        turned = cos < np.cos(np.minimum(allowed, math.pi))
-        return np.maximum.reduceat(dist, starts), np.logical_or.reduceat(turned, starts)
+        (x0, y0, z0), (ux, uy, uz), length, turn0 = self.p0, self.u, self.length, self.turn0
+        g0, g1, g2, g3, g4, g5, g6, g7, g8 = self.R_goal
+        dist: list[float] = []
+        turned: list[bool] = []
+        for (px, py, pz), (r0, r1, r2, r3, r4, r5, r6, r7, r8) in zip(P.tolist(), R.reshape(-1, 9).tolist(), strict=True):
+            vx, vy, vz = px - x0, py - y0, pz - z0
+            along = min(max(vx * ux + vy * uy + vz * uz, 0.0), length)  # the nearest point of the segment
+            ox, oy, oz = vx - along * ux, vy - along * uy, vz - along * uz
+            dist.append(math.sqrt(ox * ox + oy * oy + oz * oz))
+            # cos of the angle to the goal's orientation, (trace(goal_R_ee) - 1) / 2, against the allowed angle's
+            cos = (r0 * g0 + r1 * g1 + r2 * g2 + r3 * g3 + r4 * g4 + r5 * g5 + r6 * g6 + r7 * g7 + r8 * g8 - 1.0) / 2.0
+            allowed = ANGLE_TOLERANCE + turn0 * max(1.0 - along / CARTESIAN_STEP, 0.0)
+            turned.append(cos < math.cos(min(allowed, math.pi)))
+        ends = [*starts[1:], len(dist)]
+        return (np.array([max(dist[a:b]) for a, b in zip(starts, ends, strict=True)]),
+                np.array([any(turned[a:b]) for a, b in zip(starts, ends, strict=True)]))
+
+
+def _angle(Ra: list[float], Rb: list[float]) -> float:
+    """Angle (rad, in [0, π]) of the rotation taking ``Ra`` to ``Rb`` (row-major 3x3 lists):
+    :func:`robocfg.geometry.rotation_angle` in Python floats."""
+    c = (sum(a * b for a, b in zip(Ra, Rb, strict=True)) - 1.0) / 2.0
+    return math.acos(min(max(c, -1.0), 1.0))
 
 
 class _Unreachable(Exception):
