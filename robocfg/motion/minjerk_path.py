@@ -84,18 +84,8 @@ class _Cubic:
     def derivatives(self, s, nus: tuple[int, ...]) -> list[np.ndarray]:
         """``[path(s, nu) for nu in nus]`` (the interface of :meth:`CubicSpline.derivatives`)."""
         s = np.asarray(s, dtype=float)[..., None]
-        a, b, c, d = self.c[:, 0]
-        out = []
-        for nu in nus:
-            if nu == 0:
-                out.append(((a * s + b) * s + c) * s + d)
-            elif nu == 1:
-                out.append((3 * a * s + 2 * b) * s + c)
-            elif nu == 2:
-                out.append(6 * a * s + 2 * b)
-            else:
-                out.append(np.broadcast_to(6 * a if nu == 3 else 0 * a, s.shape[:-1] + a.shape).copy())
-        return out
+        coef = tuple(self.c[:, 0])
+        return [_horner(coef, s, nu, s.shape[:-1] + coef[0].shape) for nu in nus]
 
     def derivatives_by_column(self, s, nus: tuple[int, ...]) -> list[np.ndarray]:
         """``[path(s, nu).T for nu in nus]`` for 1-D ``s``: (n, len(s)) arrays, the same values
@@ -104,18 +94,21 @@ class _Cubic:
         s = np.asarray(s, dtype=float)
         if s.ndim != 1:
             raise ValueError("derivatives_by_column: 1-D s only")
-        a, b, c, d = (v[:, None] for v in self.c[:, 0])
-        out = []
-        for nu in nus:
-            if nu == 0:
-                out.append(((a * s + b) * s + c) * s + d)
-            elif nu == 1:
-                out.append((3 * a * s + 2 * b) * s + c)
-            elif nu == 2:
-                out.append(6 * a * s + 2 * b)
-            else:
-                out.append(np.broadcast_to(6 * a if nu == 3 else 0 * a, (len(a), len(s))).copy())
-        return out
+        coef = tuple(v[:, None] for v in self.c[:, 0])
+        return [_horner(coef, s, nu, (len(coef[0]), len(s))) for nu in nus]
+
+
+def _horner(coef: tuple[np.ndarray, ...], s: np.ndarray, nu: int, shape: tuple[int, ...]) -> np.ndarray:
+    """The ``nu``-th derivative of a·s³ + b·s² + c·s + d (``coef`` = (a, b, c, d), broadcast
+    against ``s``) by Horner's rule; ``shape``: the result's, for the constant derivatives."""
+    a, b, c, d = coef
+    if nu == 0:
+        return ((a * s + b) * s + c) * s + d
+    if nu == 1:
+        return (3 * a * s + 2 * b) * s + c
+    if nu == 2:
+        return 6 * a * s + 2 * b
+    return np.broadcast_to(6 * a if nu == 3 else 0 * a, shape).copy()
 
 
 JointSpline = _Segment | _Cubic | CubicSpline
