@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from robocfg.checks import load_task
@@ -73,3 +74,16 @@ def run_spied(task, make_spy, seed: int = 0, episodes: int = 1):
 
     report, _ = run_pick_place(task, episodes=episodes, seed=seed, record=factory)
     return report, spies[0]
+
+
+def panda_branch_case() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Panda's branch case: ``(T, T_down, q0)``. ``T`` is a top-down pre-grasp pose
+    (world_T_ee, m) whose nearest IK answer from ``q0`` (rad) has the wrist past 2.9 rad;
+    ``T_down`` is the same pose 13 cm lower. Going straight down from that answer, a joint jumps
+    (a branch is crossed); other answers of ``T`` have a continuous line."""
+    c, s = np.cos(-2.618), np.sin(-2.618)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]) @ np.diag([1.0, -1.0, -1.0]), [0.5, -0.3, 0.25]
+    T_down = T.copy()
+    T_down[2, 3] = 0.12
+    return T, T_down, np.array([1.363, -1.189, 2.155, -1.441, -1.189, 1.565, -2.799])

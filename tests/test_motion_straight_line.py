@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from _sim_helpers import PANDA
+from _sim_helpers import PANDA, panda_branch_case
 
 from robocfg.checks import load_robot
 from robocfg.geometry import rotation_angle
@@ -82,17 +82,12 @@ def test_waypoints_on_the_line_and_the_played_path_within_tolerance(kin, delta, 
 
 
 def test_a_line_that_crosses_a_branch_is_refused_and_an_unreachable_one_named():
-    """The Panda of tests/test_planning.py's branch case: 13 cm straight down from this answer a
+    """The Panda's branch case (_sim_helpers.panda_branch_case): 13 cm straight down from this answer a
     joint would jump; and a line running out of the arm's reach names where."""
     model = KinematicModel.from_robot(load_robot(PANDA))
     bound_ik_by_iterations(model)
     mover = ArmMover(None, None, model, None)  # type: ignore[arg-type]
-    c, s = np.cos(-2.618), np.sin(-2.618)
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]) @ DOWN, [0.5, -0.3, 0.25]
-    T_down = T.copy()
-    T_down[2, 3] = 0.12
-    q0 = np.array([1.363, -1.189, 2.155, -1.441, -1.189, 1.565, -2.799])
+    T, T_down, q0 = panda_branch_case()
     nearest = mover.solve(T, q0)
     with pytest.raises(MoveFailed, match=r"no continuous IK along the straight line \(a joint jumps"):
         mover.straight_waypoints(nearest, T_down)

@@ -7,7 +7,7 @@ import itertools
 
 import numpy as np
 import pytest
-from _sim_helpers import PANDA
+from _sim_helpers import PANDA, panda_branch_case
 
 from robocfg.checks import load_robot
 from robocfg.collision import EnvShape, robot_geometry
@@ -203,12 +203,7 @@ def test_goal_prefers_an_ik_answer_whose_straight_line_after_it_is_continuous(pa
     checker = CollisionChecker(kin, links, [GROUND])
     drive = PlannedDrive(JointPlanner(checker, kin.lower, kin.upper), kin, kin.ee_link, [])
     mover = ArmMover(None, None, kin, None)  # type: ignore[arg-type]  # IK only: no world
-    c, s = np.cos(-2.618), np.sin(-2.618)
-    T = np.eye(4)
-    T[:3, :3], T[:3, 3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]]) @ DOWN, [0.5, -0.3, 0.25]
-    T_down = T.copy()
-    T_down[2, 3] = 0.12
-    q0 = np.array([1.363, -1.189, 2.155, -1.441, -1.189, 1.565, -2.799])
+    T, T_down, q0 = panda_branch_case()
     nearest = mover.solve(T, q0)
     with pytest.raises(MoveFailed, match="no continuous IK along the straight line"):
         mover.straight_waypoints(nearest, T_down)
