@@ -96,6 +96,11 @@ class KinematicModel:
         # the limits and the wrap flags as Python lists, for the per-query checks of seeds and answers
         self._limit_lists = (self.lower.tolist(), self.upper.tolist())
         self._wrap_list = self.wrap.tolist()
+        self._nq = int(self.model.nq)
+        # the joints that are not wrapped (those that can sit at a limit): names, indices, limits
+        bounded = [k for k, w in enumerate(self._wrap_list) if not w]
+        lo, hi = self._limit_lists
+        self._bounded = ([self.joint_names[k] for k in bounded], bounded, [lo[k] for k in bounded], [hi[k] for k in bounded])
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -184,7 +189,7 @@ class KinematicModel:
     # ------------------------------------------------------------------ queries
     @property
     def nq(self) -> int:
-        return int(self.model.nq)
+        return self._nq
 
     @property
     def any_wrap(self) -> bool:
@@ -195,6 +200,11 @@ class KinematicModel:
     def limit_lists(self) -> tuple[list[float], list[float]]:
         """(lower, upper) limits as Python lists (read only; ``lower``/``upper`` are not changed in place)."""
         return self._limit_lists
+
+    @property
+    def bounded(self) -> tuple[list[str], list[int], list[float], list[float]]:
+        """The joints that are not wrapped (read only): (names, indices in arm order, lower, upper limits)."""
+        return self._bounded
 
     @property
     def wrap_list(self) -> list[bool]:

@@ -18,6 +18,7 @@ if TYPE_CHECKING:
 
 TWO_PI = 2 * math.pi
 LIMIT_TOL = 1e-6  # rad or m: "at a limit"
+_F64 = np.dtype(float)  # the float64 dtype (one object: a dtype check by identity)
 
 
 def check_target(target: np.ndarray) -> np.ndarray:
@@ -26,11 +27,11 @@ def check_target(target: np.ndarray) -> np.ndarray:
     Written with Python scalars: it runs once per IK query and numpy's per-call overhead would
     dominate on a 4x4 matrix.
     """
-    T = np.array(target, dtype=float)
+    T = target.copy() if type(target) is np.ndarray and target.dtype is _F64 else np.array(target, dtype=float)
     if T.shape != (4, 4):
         raise RobocfgError(f"IK target must be a 4x4 homogeneous matrix, got shape {T.shape}")
-    (a, b, c, _), (d, e, f, _), (g, h, i, _), _ = rows = T.tolist()
-    if not math.isfinite(sum(rows[0]) + sum(rows[1]) + sum(rows[2]) + sum(rows[3])):
+    (a, b, c, x), (d, e, f, y), (g, h, i, z), (m0, m1, m2, m3) = T.tolist()
+    if not math.isfinite(a + b + c + x + d + e + f + y + g + h + i + z + m0 + m1 + m2 + m3):
         raise RobocfgError("IK target contains NaN or infinite values")
     worst = max(abs(a * a + b * b + c * c - 1.0), abs(d * d + e * e + f * f - 1.0),
                 abs(g * g + h * h + i * i - 1.0), abs(a * d + b * e + c * f),
@@ -47,11 +48,18 @@ def check_seed(model: KinematicModel, seed_q: np.ndarray) -> np.ndarray:
     A seed already within the limits (the usual case: a measured or previous answer) is checked
     with Python scalars and returned as copied; ``into_limits`` would leave its values as they are.
     """
-    q = np.array(seed_q, dtype=float).reshape(-1)
-    if q.shape[0] != model.nq:
+    if type(seed_q) is np.ndarray and seed_q.dtype is _F64 and seed_q.ndim == 1:
+        q = seed_q.copy()  # what np.array(..., dtype=float) gives, without its type discovery
+    else:
+        q = np.array(seed_q, dtype=float).reshape(-1)
+    values = q.tolist()
+    if len(values) != model.nq:
         raise RobocfgError(f"seed_q has {q.shape[0]} values; the arm has {model.nq} joints")
     lo, hi = model.limit_lists
-    if all(a <= v <= b for a, v, b in zip(lo, q.tolist(), hi)):  # noqa: B905 - nq values each; False for NaN
+    for a, v, b in zip(lo, values, hi):  # noqa: B905 - nq values each
+        if not a <= v <= b:  # False for NaN
+            break
+    else:
         return q
     if not np.isfinite(q).all():
         raise RobocfgError("seed_q contains NaN or infinite values")
@@ -62,7 +70,7 @@ def prepare(model: KinematicModel, target: np.ndarray, seed_q: np.ndarray, frame
     """The checked inputs every backend starts from: (T target 4x4, q0 seed, frame id, target SE3)."""
     T = check_target(target)
     q0 = check_seed(model, seed_q)
-    return T, q0, model.frame_id(frame), pin.SE3(T[:3, :3], T[:3, 3])
+    return T, q0, model.frame_id(frame), pin.SE3(T)  # the homogeneous matrix's blocks, as from slices
 
 
 def into_limits(model: KinematicModel, q: np.ndarray) -> np.ndarray:
@@ -97,9 +105,12 @@ def residuals(T: np.ndarray, target: np.ndarray) -> tuple[float, float]:
 
 def joints_at_limit(model: KinematicModel, q: np.ndarray) -> list[str]:
     """Names of the (non-wrapped) joints within LIMIT_TOL of a limit."""
-    (lower, upper), wrap = model.limit_lists, model.wrap_list
-    return [n for n, v, lo, hi, w in zip(model.joint_names, q.tolist(), lower, upper, wrap, strict=True)
-            if not w and (v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL)]
+    names, index, lower, upper = model.bounded
+    values = q.tolist()
+    if len(index) != len(values):
+        values = [values[k] for k in index]
+    return [n for n, v, lo, hi in zip(names, values, lower, upper, strict=True)
+            if v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL]
 
 
 Descend = Callable[[np.ndarray, float, "int | None"], tuple[bool, int, float, np.ndarray]]

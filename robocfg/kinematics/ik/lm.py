@@ -64,7 +64,11 @@ class LMSolver:
         self.max_iter, self.mu, self.lambda0 = max_iter, mu, lambda0
         self.stall_ratio, self.stall_n = stall_ratio, stall_n
         self.restart_candidates = restart_candidates
-        self._eye = np.eye(model.nq)  # read only: the damping term's identity
+        # the damping system's matrix, rebuilt in place each iteration, and a view of its diagonal:
+        # JᵀJ written into it and the damping added to the diagonal alone give the same floats as
+        # JᵀJ + c·I (off the diagonal x + 0·c = x), without a 7×7 identity product and sum per step
+        self._H = np.empty((model.nq, model.nq))
+        self._H_diag = self._H.reshape(-1)[::model.nq + 1]
         # (q, position², rotation²) of each descent's best configuration in the current solve
         self._measured: list[tuple[np.ndarray, float, float]] = []
 
@@ -112,40 +116,51 @@ class LMSolver:
     def _descend(self, q: np.ndarray, Mt: pin.SE3, fid: int, position_only: bool, deadline: float,
                  max_iter: int | None = None):
         """One damped descent from ``q``: (converged, iterations, best squared error, best q); the
-        best q's squared residuals are noted in ``_measured`` (``finish`` reuses them)."""
+        best q's squared residuals are noted in ``_measured`` (``finish`` reuses them).
+
+        Per iteration the few scalars (squared errors, damping) are Python floats and the 7×7
+        system is built in place (``_H``): the same floats as numpy's 3-term dot products and
+        ``JᵀJ + c·I`` with fewer calls. A step that stays within the limits (checked in Python
+        floats) is not clamped: clamping would give back the same values."""
         km = self.km
         model, data = km.model, km.data
         lower, upper, wrap = km.lower, km.upper, km.wrap
+        lo_list, hi_list = km.limit_lists
         any_wrap = km.any_wrap
         tp2, tr2 = self.tol_pos**2, self.tol_rot**2
         mu, lam0 = self.mu, self.lambda0
         ratio, stall_n = self.stall_ratio, self.stall_n
-        eye = self._eye if self._eye.shape[0] == model.nq else np.eye(model.nq)
+        H, H_diag = self._H, self._H_diag
         cjj, ufp, gfj, log6 = pin.computeJointJacobians, pin.updateFramePlacement, pin.getFrameJacobian, pin.log6
-        mn, mx, nnz = np.minimum, np.maximum, np.count_nonzero
+        mn, mx, nnz, dot = np.minimum, np.maximum, np.count_nonzero, np.dot
         clock = self.clock
         best_s, best_q, ref_s, stall = math.inf, q, math.inf, 0
         best_pe2 = best_re2 = math.inf
-        pinned = bool(nnz(q <= lower) or nnz(q >= upper))
+        pinned = False  # some joint sits on a limit (False for NaN, as numpy's comparisons)
+        for a, v, b in zip(lo_list, q.tolist(), hi_list):  # noqa: B905 - nq values each
+            if v <= a or v >= b:
+                pinned = True
+                break
         max_iter = self.max_iter if max_iter is None else max_iter
         it = 0
         for it in range(1, max_iter + 1):
             cjj(model, data, q)
             d = ufp(model, data, fid).actInv(Mt)
             t = d.translation
-            pe2 = t.dot(t)
+            x, y, z = t.tolist()
+            pe2 = x * x + y * y + z * z  # t·t in Python floats, left to right
             if position_only:
                 re2 = 0.0
                 e = t
             else:
                 e = log6(d).vector  # SE(3) log: its angular part is log3 of the rotation error
-                w = e[3:]
-                re2 = w.dot(w)
+                _, _, _, x, y, z = e.tolist()
+                re2 = x * x + y * y + z * z
             s = pe2 + re2
             if s < best_s:
                 best_s, best_q, best_pe2, best_re2 = s, q, pe2, re2
             if pe2 <= tp2 and re2 <= tr2:
-                self._measured.append((q, float(pe2), float(re2)))
+                self._measured.append((q, pe2, re2))
                 return True, it, s, q
             if s < ref_s * ratio:
                 ref_s, stall = s, 0
@@ -157,7 +172,8 @@ class LMSolver:
             if position_only:
                 J = J[:3]
             Jt = J.T
-            H = Jt.dot(J) + (mu * s + lam0) * eye
+            dot(Jt, J, out=H)  # JᵀJ, symmetric to the bit
+            H_diag += mu * s + lam0
             g = Jt.dot(e)
             dq = dposv(H, g)[1]
             froze = False
@@ -171,18 +187,21 @@ class LMSolver:
                     g[blk] = 0.0
                     dq = dposv(H, g)[1]
             qn = q + dq
-            q = mn(mx(qn, lower), upper)
-            if nnz(q != qn):  # a joint left its limits (or NaN)
-                if any_wrap:  # a wrapped joint leaving its (≥ 2π wide) range re-enters from the other side
-                    over, under = (qn > upper) & wrap, (qn < lower) & wrap
-                    if nnz(over) or nnz(under):
-                        qn = qn - TWO_PI * over + TWO_PI * under
-                        q = mn(mx(qn, lower), upper)
-                pinned = froze or bool(nnz(q != qn))
-            else:
+            for a, v, b in zip(lo_list, qn.tolist(), hi_list):  # noqa: B905 - nq values each
+                if not a <= v <= b:  # a joint left its limits (or NaN): clamp, wrap
+                    q = mn(mx(qn, lower), upper)
+                    if any_wrap:  # a wrapped joint leaving its (≥ 2π wide) range re-enters from the other side
+                        over, under = (qn > upper) & wrap, (qn < lower) & wrap
+                        if nnz(over) or nnz(under):
+                            qn = qn - TWO_PI * over + TWO_PI * under
+                            q = mn(mx(qn, lower), upper)
+                    pinned = froze or q.tolist() != qn.tolist()
+                    break
+            else:  # within the limits: clamping would return the same values
+                q = qn
                 pinned = froze
             if clock() >= deadline:
                 break
         if best_pe2 != math.inf:
-            self._measured.append((best_q, float(best_pe2), float(best_re2)))
+            self._measured.append((best_q, best_pe2, best_re2))
         return False, it, best_s, best_q
