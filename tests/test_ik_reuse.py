@@ -11,7 +11,16 @@ import pinocchio as pin
 import pytest
 
 from robocfg.checks import load_robot
-from robocfg.kinematics.ik.common import check_seed, finish, into_limits, prepare
+from robocfg.errors import RobocfgError
+from robocfg.kinematics.ik.common import (
+    LIMIT_TOL,
+    check_seed,
+    check_target,
+    finish,
+    into_limits,
+    joints_at_limit,
+    prepare,
+)
 from robocfg.kinematics.model import KinematicModel
 from robocfg.motion.moves import ArmMover, bound_ik_by_iterations
 
@@ -65,6 +74,46 @@ def test_a_seed_inside_the_limits_is_used_as_given(model: KinematicModel) -> Non
         check_seed(model, np.full(model.nq, np.nan))
     _, q0, _, _ = prepare(model, np.eye(4), outside, "ee")
     assert model.within_limits(q0)
+
+
+def test_a_rotation_checked_once_still_rejects_others(model: KinematicModel) -> None:
+    """check_target skips the rotation check for the rotation it last accepted (a straight line's
+    targets share one): any other rotation, and a non-finite translation, are still refused."""
+    T = model.fk(model.home, "ee")
+    assert np.array_equal(check_target(T), T) and check_target(T) is not T
+    moved = T.copy()
+    moved[:3, 3] += 0.1
+    assert np.array_equal(check_target(moved), moved)  # the same rotation, accepted again
+    for bad in (1.001, -1.0):  # scaled, reflected
+        wrong = moved.copy()
+        wrong[:3, :3] *= bad
+        with pytest.raises(RobocfgError, match="not a rotation matrix"):
+            check_target(wrong)
+    moved[0, 3] = np.nan
+    with pytest.raises(RobocfgError, match="NaN"):
+        check_target(moved)
+    with pytest.raises(RobocfgError, match="4x4"):
+        check_target(T[:3])
+
+
+def test_joints_at_limit_by_definition(model: KinematicModel) -> None:
+    """The joints within LIMIT_TOL of a limit, wrapped joints never, as a plain reading of the limits."""
+    rng = np.random.default_rng(5)
+    lo, hi = model.lower, model.upper
+    for _ in range(50):
+        q = rng.uniform(lo, hi)
+        pick = rng.integers(0, 4, model.nq)  # 0: inside, 1: at lower, 2: near upper, 3: just beyond the tolerance
+        q = np.where(pick == 1, lo, q)
+        q = np.where(pick == 2, hi - 0.5 * LIMIT_TOL, q)
+        q = np.where(pick == 3, lo + 2 * LIMIT_TOL, q)
+        want = [n for n, v, a, b, w in zip(model.joint_names, q, lo, hi, model.wrap, strict=True)
+                if not w and (v - a <= LIMIT_TOL or b - v <= LIMIT_TOL)]
+        assert joints_at_limit(model, q) == want
+    if model.any_wrap:  # a wrapped joint at its limit is not reported
+        k = int(np.flatnonzero(model.wrap)[0])
+        q = model.home.copy()
+        q[k] = hi[k]
+        assert model.joint_names[k] not in joints_at_limit(model, q)
 
 
 class _World:

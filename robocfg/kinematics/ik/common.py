@@ -33,13 +33,20 @@ def check_target(target: np.ndarray) -> np.ndarray:
     (a, b, c, x), (d, e, f, y), (g, h, i, z), (m0, m1, m2, m3) = T.tolist()
     if not math.isfinite(a + b + c + x + d + e + f + y + g + h + i + z + m0 + m1 + m2 + m3):
         raise RobocfgError("IK target contains NaN or infinite values")
+    rotation = (a, b, c, d, e, f, g, h, i)
+    if rotation == _last_rotation[0]:  # a straight line's targets share the goal's rotation: checked once
+        return T
     worst = max(abs(a * a + b * b + c * c - 1.0), abs(d * d + e * e + f * f - 1.0),
                 abs(g * g + h * h + i * i - 1.0), abs(a * d + b * e + c * f),
                 abs(a * g + b * h + c * i), abs(d * g + e * h + f * i))
     det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
     if worst > 1e-6 or abs(det - 1.0) > 1e-6:
         raise RobocfgError("IK target rotation is not a rotation matrix (orthonormal, det +1)")
+    _last_rotation[0] = rotation
     return T
+
+
+_last_rotation: list[tuple[float, ...]] = [()]  # the rotation block (row-major) check_target last accepted
 
 
 def check_seed(model: KinematicModel, seed_q: np.ndarray) -> np.ndarray:
@@ -109,8 +116,11 @@ def joints_at_limit(model: KinematicModel, q: np.ndarray) -> list[str]:
     values = q.tolist()
     if len(index) != len(values):
         values = [values[k] for k in index]
-    return [n for n, v, lo, hi in zip(names, values, lower, upper, strict=True)
-            if v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL]
+    out = []
+    for n, v, lo, hi in zip(names, values, lower, upper):  # noqa: B905 - one value per bounded joint
+        if v - lo <= LIMIT_TOL or hi - v <= LIMIT_TOL:
+            out.append(n)
+    return out
 
 
 Descend = Callable[[np.ndarray, float, "int | None"], tuple[bool, int, float, np.ndarray]]

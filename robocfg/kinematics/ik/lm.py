@@ -88,7 +88,11 @@ class LMSolver:
                                          lambda rng: self._restart(rng, Mt, fid, position_only), whole_first=True)
         q = nearest_equivalent(km, best_q, q0)
         # the residuals the descent measured at this very configuration, if it did: finish needs no FK
-        squared = next(((pe2, re2) for qm, pe2, re2 in self._measured if qm is best_q), None)
+        squared = None
+        for qm, pe2, re2 in self._measured:
+            if qm is best_q:
+                squared = pe2, re2
+                break
         self._measured = []
         if squared is not None and q is not best_q and not (q == best_q).all():
             squared = None  # a wrapped joint moved by 2π: measure it again
