@@ -1,6 +1,7 @@
 """Worlds nothing draws load their robots without visual meshes (``World(visuals=False)``, PyBullet's
-``URDF_IGNORE_VISUAL_SHAPES``): the physics is the same bit for bit, and every session that draws
-(a recording, a dataset with cameras, grasp perception) still loads them."""
+``URDF_IGNORE_VISUAL_SHAPES``) and without PyBullet's TinyRenderer (``robocfg.sim.renderer``): the
+physics is the same bit for bit, drawing such a world is an error rather than a blank picture, and
+every session that draws (a recording, a dataset with cameras, grasp perception) still loads them."""
 
 from __future__ import annotations
 
@@ -16,6 +17,10 @@ from robocfg.checks.task import load_task
 from robocfg.config import catalog
 from robocfg.engine import RunOptions, open_session
 from robocfg.engine.options import EpisodeObserver
+from robocfg.errors import RobocfgError
+from robocfg.sim import renderer
+from robocfg.sim.record_camera import CameraView, render
+from robocfg.sim.render_mirror import RenderMirror
 from robocfg.sim.world import World
 
 
@@ -62,7 +67,8 @@ def test_pick_place_episode_is_the_same_without_visual_meshes() -> None:
     try:
         assert drawn.world.visuals and not plain.world.visuals
         assert any("/visual/" in f for f in _visual_files(drawn.world))
-        assert not any("/visual/" in f for f in _visual_files(plain.world))  # collision shapes drawn instead
+        # the plain world has no renderer, so no visual shapes at all (robocfg.sim.renderer)
+        assert renderer.has_renderer(drawn.world.client) and not renderer.has_renderer(plain.world.client)
         mine = _Hasher(plain.world)
         plain.world.step_hooks.append(mine.maybe_capture)
         a, b = drawn.run(0), plain.run(0)
@@ -110,3 +116,21 @@ def test_sessions_that_draw_load_the_visual_meshes(tmp_path) -> None:
         assert s.world.visuals  # grasp perception's depth camera sees the robot as drawn
     finally:
         s.close()
+
+
+def test_a_world_without_renderer_refuses_to_draw() -> None:
+    """Pictures of a world built without its renderer would be blank: drawing it raises, and a
+    client id reused after the world closes draws again."""
+    task = load_task(catalog.find("tasks", "pick_place"))
+    with World(task, visuals=False) as w:
+        c = w.client
+        assert not renderer.has_renderer(c)
+        with pytest.raises(RobocfgError, match="without a renderer"):
+            render(c, CameraView(), (32, 24))
+        with pytest.raises(RobocfgError, match="without a renderer"):
+            RenderMirror(c)  # a dataset camera's mirror reads the world's visual shapes
+    assert renderer.has_renderer(c)
+    with World(task, visuals=True) as w:
+        assert w.client == c and renderer.has_renderer(c)
+        img = render(c, CameraView(), (32, 24))
+        assert img.shape == (24, 32, 3) and len(np.unique(img.reshape(-1, 3), axis=0)) > 1  # not blank

@@ -15,6 +15,7 @@ import numpy as np
 import pybullet as p
 
 from robocfg.config.commands import Camera
+from robocfg.sim.renderer import require_renderer
 
 
 @dataclass(frozen=True)
@@ -54,6 +55,7 @@ def _up_vector(cam: Camera) -> np.ndarray:
 def capture(client: int, cam: Camera, rng: np.random.Generator | None = None) -> RGBD:
     """Render ``cam`` in the world ``client``; depth noise (``depth_noise_std``, m, Gaussian along
     the optical axis) needs ``rng``."""
+    require_renderer(client)
     view, proj = matrices(cam)
     w, h = cam.width, cam.height
     img = p.getCameraImage(w, h, view.T.reshape(-1).tolist(), proj.T.reshape(-1).tolist(),

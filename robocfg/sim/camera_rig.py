@@ -25,6 +25,7 @@ import pybullet as p
 from robocfg.config.cameras import TaskCamera
 from robocfg.sim.low_poly import MAX_FACES
 from robocfg.sim.render_mirror import RenderMirror, make_mirror
+from robocfg.sim.renderer import require_renderer
 
 Renderer = Literal["auto", "tiny", "exact", "egl"]
 
@@ -58,6 +59,7 @@ class CameraRig:
             T = self.arm.ee_pose() if T_ee is None else T_ee
             eye, target, up = T[:3, :3] @ eye + T[:3, 3], T[:3, :3] @ target + T[:3, 3], T[:3, :3] @ up
         c = self.world.client
+        require_renderer(c)
         view = p.computeViewMatrix(eye.tolist(), target.tolist(), up.tolist(), physicsClientId=c)
         proj = self._proj.get(cam.name)
         if proj is None:

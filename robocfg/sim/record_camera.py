@@ -12,6 +12,7 @@ import numpy as np
 import pybullet as p
 
 from robocfg.sim.record_overlay import Marker
+from robocfg.sim.renderer import require_renderer
 
 
 @dataclass(frozen=True)
@@ -112,6 +113,7 @@ def view_projection(client: int, camera: CameraView, size: tuple[int, int]) -> t
 
 def render(client: int, camera: CameraView, size: tuple[int, int]) -> np.ndarray:
     """One RGB image (H, W, 3) uint8 of the client's bodies seen by ``camera`` (TinyRenderer)."""
+    require_renderer(client)
     w, h = size
     view, proj = view_projection(client, camera, size)
     img = p.getCameraImage(w, h, view, proj, renderer=p.ER_TINY_RENDERER, shadow=int(camera.shadow),

@@ -25,6 +25,7 @@ import numpy as np
 import pybullet as p
 
 from robocfg.sim.low_poly import MAX_FACES, Part, low_poly
+from robocfg.sim.renderer import require_renderer
 
 LINK_FRAME = 4  # getLinkState index of the URDF link frame's world position (then orientation)
 GROW = 0.03  # m added around each moving link's collision box: visual meshes reach a little further
@@ -96,6 +97,7 @@ class RenderMirror:
     """
 
     def __init__(self, source: int, max_faces: int | None = MAX_FACES, egl: bool = False):
+        require_renderer(source)  # its visual shapes are read from the source's renderer
         self.source = source
         self.max_faces = max_faces
         self.egl = egl

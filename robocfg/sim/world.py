@@ -50,6 +50,7 @@ from robocfg.config.scene import Body
 from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
+from robocfg.sim import renderer
 from robocfg.sim.bodies import ShapeCache, spawn_body, spawn_ground, spawn_pedestal, spawn_table
 from robocfg.sim.gripper import Gripper, make_gripper
 from robocfg.sim.loading import filter_gripper_linkage, load_robot_urdf
@@ -73,10 +74,11 @@ class World(SceneQueries):
         self.task = task
         cfg = task.config
         self.gui = gui or cfg.sim.gui
-        # False: robots load without their URDF visual meshes (PyBullet's URDF_IGNORE_VISUAL_SHAPES;
-        # TinyRenderer then draws their collision shapes): for worlds nothing draws. Physics is the
-        # same (collision shapes, masses and inertias come from the rest of the URDF); loading the
-        # Panda's 9 MB of visual OBJs costs ≈ 0.2–0.4 s a process. The GUI always loads them.
+        # False: for worlds nothing draws. Robots load without their URDF visual meshes (PyBullet's
+        # URDF_IGNORE_VISUAL_SHAPES; loading the Panda's 9 MB of visual OBJs costs ≈ 0.2–0.4 s a
+        # process) and the client goes without its TinyRenderer (robocfg.sim.renderer), which would
+        # otherwise convert every link's collision meshes for drawing. Physics is the same (collision
+        # shapes, masses and inertias come from the rest of the URDF). The GUI always loads them.
         self.visuals: bool = visuals or self.gui
         self.dt: float = cfg.sim.timestep
         self.t: float = 0.0
@@ -107,6 +109,8 @@ class World(SceneQueries):
         if self.client < 0:
             raise RobocfgError("cannot open the PyBullet GUI (is there a display?); run without --gui"
                                if self.gui else "cannot start a PyBullet DIRECT client")
+        if not self.visuals:
+            renderer.drop_renderer(self.client)
         try:
             self._build()
         except BaseException:
@@ -124,6 +128,7 @@ class World(SceneQueries):
         if self.client is not None and self.client >= 0:
             with contextlib.suppress(p.error):
                 p.disconnect(physicsClientId=self.client)
+            renderer.forget(self.client)
             self.client = -1
 
     # ---- building -----------------------------------------------------------------------
