@@ -85,6 +85,7 @@ class KinematicModel:
     # ``ik`` then returns each continuous joint at the turn nearest to the seed, unbounded.
     continuous: np.ndarray | None = None
     _solvers: dict[str, IKSolver] = field(default_factory=dict, repr=False)
+    _levers: dict[str, tuple[float, ...] | None] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         # OP_FRAME: a URDF link that happens to be called 'tcp' is a BODY frame and stays reachable by type
@@ -226,6 +227,15 @@ class KinematicModel:
     def frame_name(self, frame: str = TCP_FRAME) -> str:
         """The pinocchio frame name behind ``frame`` ("ee" → the ee_link)."""
         return self.model.frames[self.frame_id(frame)].name
+
+    def lever_arms(self, frame: str = TCP_FRAME) -> tuple[float, ...] | None:
+        """Per joint, a bound (m) on the distance from its axis to ``frame``'s origin at every
+        configuration (:func:`robocfg.kinematics.lever_arms.lever_arms`), computed once per frame."""
+        if frame not in self._levers:
+            from robocfg.kinematics.lever_arms import lever_arms
+
+            self._levers[frame] = lever_arms(self.model, self.frame_id(frame))
+        return self._levers[frame]
 
     def fk(self, q: np.ndarray, frame: str = TCP_FRAME) -> np.ndarray:
         """world_T_frame (4x4) at joint values ``q`` (arm order)."""

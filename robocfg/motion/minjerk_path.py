@@ -10,6 +10,8 @@ Units: rad, s.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from robocfg.motion.cubic import CubicSpline  # scipy's bits without importing scipy.interpolate
@@ -145,12 +147,12 @@ def joint_path_knots(waypoints: np.ndarray) -> tuple[np.ndarray, JointSpline, np
     return W, CubicSpline(knots, W, axis=0, bc_type="not-a-knot"), knots
 
 
-def derivative_bounds(path: JointSpline) -> tuple[np.ndarray, np.ndarray]:
-    """Per joint, the exact maxima of |dq/ds| and |d²q/ds²| over s ∈ [0, 1]: on each cubic
-    piece the second derivative is linear (largest at an end) and the first quadratic (largest at
-    an end or at its vertex)."""
+def derivative_bounds(path: JointSpline) -> tuple[list[float], list[float]]:
+    """Per joint, the exact maxima of |dq/ds| and |d²q/ds²| over s ∈ [0, 1] (Python floats): on
+    each cubic piece the second derivative is linear (largest at an end) and the first quadratic
+    (largest at an end or at its vertex)."""
     if isinstance(path, _Segment):
-        return np.abs(path.delta), np.zeros(len(path.delta))
+        return [abs(v) for v in path.delta.tolist()], [0.0] * len(path.delta)
     if isinstance(path, _Cubic):  # one piece on [0, 1], a few joints: scalar arithmetic is cheaper
         d1, d2 = [], []
         for a, b, c in zip(*path.c[:3, 0].tolist(), strict=True):  # a·s³ + b·s² + c·s + d
@@ -159,14 +161,14 @@ def derivative_bounds(path: JointSpline) -> tuple[np.ndarray, np.ndarray]:
                 m = max(m, abs(c - b * b / (3 * a)))
             d1.append(m)
             d2.append(max(abs(2 * b), abs(6 * a + 2 * b)))
-        return np.array(d1), np.array(d2)
+        return d1, d2
     c3, c2, c1 = path.c[0], path.c[1], path.c[2]  # (pieces, n): c3·t³ + c2·t² + c1·t + c0, t ∈ [0, h]
     h = np.diff(path.x)[:, None]
     d2 = np.maximum(np.abs(2 * c2), np.abs(6 * c3 * h + 2 * c2)).max(axis=0)
     vertex = np.clip(np.divide(-c2, 3 * c3, out=np.zeros_like(c3), where=c3 != 0), 0.0, h)
     d1 = np.maximum.reduce([np.abs(c1), np.abs((3 * c3 * h + 2 * c2) * h + c1),
                             np.abs((3 * c3 * vertex + 2 * c2) * vertex + c1)]).max(axis=0)
-    return d1, d2
+    return d1.tolist(), d2.tolist()
 
 
 class MinJerkPath(Trajectory):
@@ -180,8 +182,11 @@ class MinJerkPath(Trajectory):
                  path: tuple[np.ndarray, JointSpline] | None = None):
         self.waypoints, self.spline = joint_path(waypoints) if path is None else path
         d1, d2 = derivative_bounds(self.spline)
-        t_vel = PEAK_SPEED * np.max(d1 / limits.velocity)
-        t_acc = np.sqrt(np.max((d2 * PEAK_SPEED**2 + d1 * PEAK_ACCEL) / limits.acceleration))
+        self.path_bounds = (d1, d2)  # per joint, max |dq/ds| and |d²q/ds²| (rad): the EE's bound uses them too
+        # in Python floats: each quotient, product and sum the one numpy's elementwise version makes
+        t_vel = PEAK_SPEED * max(a / v for a, v in zip(d1, limits.velocity.tolist(), strict=True))
+        t_acc = math.sqrt(max((b * PEAK_SPEED**2 + a * PEAK_ACCEL) / c
+                              for a, b, c in zip(d1, d2, limits.acceleration.tolist(), strict=True)))
         self.duration = float(max(t_vel, t_acc, min_duration))
 
     def positions_velocities(self, t) -> tuple[np.ndarray, np.ndarray]:

@@ -42,8 +42,6 @@ TIMEOUT_FACTOR = 1.25  # a move without a fixed timeout may take its planned dur
 TIMEOUT_MARGIN = 1.0  # ... + this many seconds (s) to settle and converge
 UNPLANNED_TIMEOUT = 4.0  # s: the limit of a move that has no plan to measure (convergence only)
 REACTIVE_DETOUR = 2.0  # a reactive move may take this many times the direct move (it goes round obstacles)
-ACCEL_SAMPLES = 41  # instants at which a move's EE acceleration is measured against max_acceleration
-MIN_ACCELERATION = 0.5  # m/s²: the lowest EE acceleration limit honoured (a tighter one would crawl)
 IK_ITERATIONS = 400  # LM iterations per IK query over all restarts (see bound_ik_by_iterations)
 
 
@@ -203,13 +201,12 @@ class ArmMover:
         return traj if k <= 1.0 else Slowed(traj, k)
 
     def _stretch(self, traj, a_max: float) -> float:
-        """Factor (≥ 1) by which to slow ``traj`` so that the EE's peak acceleration (m/s², from
-        FK at ``ACCEL_SAMPLES`` instants, second differences) stays within ``a_max``: time scaled
-        by c scales accelerations by 1/c²."""
-        t = np.linspace(0.0, traj.duration, ACCEL_SAMPLES)
-        P = self.model.fk_positions(traj.positions(t), "ee")
-        peak = float(np.linalg.norm(np.diff(P, 2, axis=0), axis=1).max()) / (t[1] - t[0]) ** 2
-        return max(1.0, math.sqrt(peak / max(a_max, MIN_ACCELERATION)))
+        """Factor (≥ 1) by which to slow ``traj`` so that the EE's peak acceleration stays within
+        ``a_max`` (m/s²; :func:`robocfg.motion.ee_acceleration.stretch_factor`): time scaled by c
+        scales accelerations by 1/c²."""
+        from robocfg.motion.ee_acceleration import stretch_factor
+
+        return stretch_factor(self.model, traj, a_max)
 
     def play(self, traj) -> None:
         """Send the trajectory's position and velocity targets every physics step (no tracking
