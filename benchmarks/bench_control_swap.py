@@ -76,6 +76,14 @@ class Swap:
             src_module, src_qual = source.split(":") if source else (module, qual)
             holder, attr = _resolve(importlib.import_module(module), qual)
             self.items.append((holder, attr, vars(holder).get(attr), _base_function(base, src_module, src_qual)))
+        # a base function that calls another swapped function by a module-level name (imported or
+        # its own module's) calls the base's version of it: the base's functions work together
+        for *_, before in self.items:
+            names = before.__globals__
+            for name, value in list(names.items()):
+                for _, _, today, other in self.items:
+                    if today is not None and value is today:
+                        names[name] = other
 
     def use(self, old: bool) -> None:
         for holder, attr, today, before in self.items:

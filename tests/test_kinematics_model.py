@@ -170,3 +170,13 @@ def test_fk_positions_are_the_translations_of_fk() -> None:
     assert np.linalg.norm(model.fk_positions(qs[:1], "ee") - model.fk_positions(qs[:1], finger)) > 1e-3
     with pytest.raises(RobocfgError, match="shape"):
         model.fk_positions(qs[:, :3], "ee")
+
+
+def test_fk_pose_rows_are_fk_as_lists() -> None:
+    """The straight lines' FK check: each row's ``fk`` as nested Python floats, the same bits."""
+    model = KinematicModel.from_robot(load_robot(PANDA))
+    qs = np.random.default_rng(4).uniform(model.lower, model.upper, (7, model.nq))
+    for frame in ("ee", "tcp"):
+        assert model.fk_pose_rows(qs, frame) == [model.fk(q, frame).tolist() for q in qs]
+    with pytest.raises(RobocfgError, match="shape"):
+        model.fk_pose_rows(qs[:, :3], "ee")

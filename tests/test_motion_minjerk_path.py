@@ -66,3 +66,56 @@ def test_few_waypoints_give_scipys_not_a_knot_spline_and_exact_derivative_bounds
         assert np.all(d1 >= np.abs(ref(dense, 1)).max(axis=0) - 1e-9)
         assert np.all(d1 <= np.abs(ref(dense, 1)).max(axis=0) * (1 + 1e-6) + 1e-9)
         assert np.allclose(d2, np.abs(ref(dense, 2)).max(axis=0))
+
+
+def _numpy_joint_path_knots(waypoints):
+    """The path's knots and polynomial coefficients as the numpy version computed them (seventh
+    session): the reference for the Python-float version's bits."""
+    W = np.array(waypoints, dtype=float)
+    seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
+    moved = seg > 1e-9
+    if len(W) < 2 or not moved.all():
+        W = W[np.concatenate([[True], moved])]
+        seg = np.linalg.norm(np.diff(W, axis=0), axis=1) if len(W) >= 2 else np.array([1.0])
+        if len(W) < 2:
+            W = np.vstack([W, W])
+    if len(W) == 2:
+        return W, np.array([0.0, 1.0]), None
+    x = np.concatenate([[0.0], np.cumsum(seg)])
+    x /= x[-1]
+    if len(W) > 4:
+        return W, x, None
+    f01 = (W[1] - W[0]) / (x[1] - x[0])
+    f12 = (W[2] - W[1]) / (x[2] - x[1])
+    f012 = (f12 - f01) / (x[2] - x[0])
+    if len(W) == 4:
+        f23 = (W[3] - W[2]) / (x[3] - x[2])
+        f0123 = ((f23 - f12) / (x[3] - x[1]) - f012) / (x[3] - x[0])
+    else:
+        f0123 = np.zeros_like(f012)
+    x1, x2 = float(x[1]), float(x[2]) if len(W) == 4 else 0.0
+    return W, x, np.stack((f0123, f012 - f0123 * (x1 + x2), f01 - f012 * x1 + f0123 * x1 * x2, W[0]))[:, None, :]
+
+
+@pytest.mark.parametrize("n", [6, 7, 8, 9])
+def test_joint_path_knots_in_floats_are_the_numpy_versions_bits(n):
+    """Knots and coefficients (what a move plays) are the bits the numpy version made, for every
+    waypoint count, scale and joint count (from 8 joints numpy's pairwise sums are used as they are)."""
+    from robocfg.motion.minjerk_path import _Cubic, _Segment, joint_path_knots
+
+    rng = np.random.default_rng(n)
+    for k in (2, 3, 4, 5, 7):
+        for _ in range(200):
+            W = np.cumsum(rng.normal(0.0, 0.3, (k, n)) * rng.choice([1e-4, 1.0, 30.0], (k, n)), axis=0)
+            if rng.random() < 0.1:
+                W[-1] = W[-2]  # a repeated waypoint: dropped
+            W_ref, x_ref, c_ref = _numpy_joint_path_knots(W)
+            W_new, path, knots = joint_path_knots(W)
+            assert W_new.tobytes() == W_ref.tobytes()
+            assert np.array(knots).tobytes() == x_ref.tobytes()
+            if c_ref is not None:
+                assert isinstance(path, _Cubic) and path.c.tobytes() == c_ref.tobytes()
+            elif len(W_ref) == 2:
+                assert isinstance(path, _Segment)
+            else:
+                assert path.x.tobytes() == x_ref.tobytes()

@@ -147,3 +147,11 @@ def test_a_pick_place_episodes_ee_stays_on_its_lines_in_the_world(monkeypatch):
             assert np.linalg.norm(v - a * u) < 0.15e-3
             if a > sl.CARTESIAN_STEP:
                 assert rotation_angle(T[:3, :3], T_goal[:3, :3]) < math.radians(0.02)
+
+
+def test_linspace_in_floats_is_numpys():
+    rng = np.random.default_rng(8)
+    for _ in range(500):
+        a, num = float(rng.uniform(0.0, 0.99)), int(rng.integers(2, 40))
+        assert sl._linspace(a, 1.0, num) == np.linspace(a, 1.0, num).tolist()
+    assert sl._linspace(0.0, 1.0, 2) == [0.0, 1.0]

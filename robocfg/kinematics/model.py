@@ -258,20 +258,20 @@ class KinematicModel:
             out[k] = place(model, data, fid).translation
         return out
 
-    def fk_poses(self, qs: np.ndarray, frame: str = TCP_FRAME) -> tuple[np.ndarray, np.ndarray]:
-        """World positions (n, 3), m, and rotation matrices (n, 3, 3) of ``frame`` at each row of
-        ``qs`` (n, nq): :meth:`fk` for a sampled path in one call."""
+    def fk_pose_rows(self, qs: np.ndarray, frame: str = TCP_FRAME) -> list[list[list[float]]]:
+        """world_T_frame (4 rows of 4 floats; m) at each row of ``qs`` (n, nq): :meth:`fk` for a
+        sampled path in one call, as Python floats for per-sample arithmetic (one conversion a
+        sample: cheaper than an array filled and converted, or numpy arithmetic on a few rows)."""
         qs = np.asarray(qs, dtype=float)
         if qs.ndim != 2 or qs.shape[1] != self.nq:
             raise RobocfgError(f"expected rows of {self.nq} joint values ({', '.join(self.joint_names)}), got shape {qs.shape}")
         model, data, fid = self.model, self.data, self.frame_id(frame)
         fk, place = pin.forwardKinematics, pin.updateFramePlacement
-        P, R = np.empty((len(qs), 3)), np.empty((len(qs), 3, 3))
-        for k, q in enumerate(qs):
+        out = []
+        for q in qs:
             fk(model, data, q)
-            M = place(model, data, fid)
-            P[k], R[k] = M.translation, M.rotation
-        return P, R
+            out.append(place(model, data, fid).homogeneous.tolist())
+        return out
 
     def jacobian(self, q: np.ndarray, frame: str = TCP_FRAME) -> np.ndarray:
         """(6, nq) Jacobian of ``frame``: rows (v, ω) of the frame origin, world-aligned axes."""

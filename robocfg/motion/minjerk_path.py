@@ -11,6 +11,7 @@ Units: rad, s.
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 
 import numpy as np
 
@@ -66,18 +67,25 @@ class _Cubic:
     ``x`` = [0, 1] in ``CubicSpline``'s layout (highest power first), one piece; ``path(s, order)``
     by Horner's rule."""
 
-    def __init__(self, x: np.ndarray, W: np.ndarray):
-        f01 = (W[1] - W[0]) / (x[1] - x[0])
-        f12 = (W[2] - W[1]) / (x[2] - x[1])
-        f012 = (f12 - f01) / (x[2] - x[0])
-        if len(W) == 4:
-            f23 = (W[3] - W[2]) / (x[3] - x[2])
-            f0123 = ((f23 - f12) / (x[3] - x[1]) - f012) / (x[3] - x[0])
-        else:
-            f0123 = np.zeros_like(f012)
-        x1, x2 = float(x[1]), float(x[2]) if len(W) == 4 else 0.0  # x[0] = 0
-        # W0 + f01·s + f012·s(s − x1) + f0123·s(s − x1)(s − x2), in powers of s
-        self.c = np.stack((f0123, f012 - f0123 * (x1 + x2), f01 - f012 * x1 + f0123 * x1 * x2, W[0]))[:, None, :]
+    def __init__(self, x: list[float], W: list[list[float]]):
+        # Python floats, a joint at a time: each difference, quotient and product the one the
+        # elementwise numpy version makes (the same bits), without a dozen small-array calls
+        x1, x2 = x[1], x[2] if len(W) == 4 else 0.0  # x[0] = 0
+        c3, c2, c1 = [], [], []
+        for j, w0 in enumerate(W[0]):
+            f01 = (W[1][j] - w0) / (x[1] - x[0])
+            f12 = (W[2][j] - W[1][j]) / (x[2] - x[1])
+            f012 = (f12 - f01) / (x[2] - x[0])
+            if len(W) == 4:
+                f23 = (W[3][j] - W[2][j]) / (x[3] - x[2])
+                f0123 = ((f23 - f12) / (x[3] - x[1]) - f012) / (x[3] - x[0])
+            else:
+                f0123 = 0.0
+            # W0 + f01·s + f012·s(s − x1) + f0123·s(s − x1)(s − x2), in powers of s
+            c3.append(f0123)
+            c2.append(f012 - f0123 * (x1 + x2))
+            c1.append(f01 - f012 * x1 + f0123 * x1 * x2)
+        self.c = np.array([c3, c2, c1, W[0]])[:, None, :]
         self.x = np.array([0.0, 1.0])
 
     def __call__(self, s, order: int = 0) -> np.ndarray:
@@ -126,25 +134,59 @@ def joint_path(waypoints: np.ndarray) -> tuple[np.ndarray, JointSpline]:
     return W, path
 
 
-def joint_path_knots(waypoints: np.ndarray) -> tuple[np.ndarray, JointSpline, np.ndarray]:
+def joint_path_knots(waypoints: np.ndarray) -> tuple[np.ndarray, JointSpline, list[float]]:
     """:func:`joint_path` and the path's parameter at each kept waypoint (0 … 1)."""
     W = np.array(waypoints, dtype=float)  # a copy: the path keeps its own waypoints
-    seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
-    moved = seg > 1e-9
+    if W.ndim == 2 and len(W) >= 2 and W.shape[1] < 8:  # the usual case, in Python floats
+        rows = W.tolist()
+        seg = [_chord(a, b) for a, b in pairwise(rows)]
+        if all(v > 1e-9 for v in seg):  # no repeated waypoint
+            return _through(W, rows, seg)
+    seg_a = np.linalg.norm(np.diff(W, axis=0), axis=1)
+    moved = seg_a > 1e-9
     if len(W) < 2 or not moved.all():  # repeated waypoints dropped (else W and seg stay as they are)
         W = W[np.concatenate([[True], moved])]
         if len(W) < 2:
             W = np.vstack([W, W])
-            seg = np.array([1.0])
+            seg_a = np.array([1.0])
         else:
-            seg = np.linalg.norm(np.diff(W, axis=0), axis=1)
-    if len(W) == 2:  # a straight segment: linear in s
-        return W, _Segment(W), np.array([0.0, 1.0])
-    knots = np.concatenate([[0.0], np.cumsum(seg)])
-    knots /= knots[-1]
-    if len(W) <= 4:
-        return W, _Cubic(knots, W), knots
-    return W, CubicSpline(knots, W, axis=0, bc_type="not-a-knot"), knots
+            seg_a = np.linalg.norm(np.diff(W, axis=0), axis=1)
+    return _through(W, W.tolist(), seg_a.tolist())
+
+
+def _chord(a: list[float], b: list[float]) -> float:
+    """``np.linalg.norm(b − a)`` bit for bit for fewer than 8 values (numpy sums so few squares
+    one after another from 0; from 8 on it sums pairwise, hence the caller's limit)."""
+    total = 0.0
+    for u, v in zip(a, b, strict=True):
+        d = v - u
+        total += d * d
+    return math.sqrt(total)
+
+
+def _through(W: np.ndarray, rows: list[list[float]], seg: list[float]) -> tuple[np.ndarray, JointSpline, list[float]]:
+    """The path through the waypoints ``W`` (also as ``rows``) with chord lengths ``seg``: the
+    knots are their running sums over the total (numpy's cumsum, then a division, in floats)."""
+    if len(rows) == 2:  # a straight segment: linear in s
+        return W, _Segment(W), [0.0, 1.0]
+    knots, total = [0.0], 0.0
+    for v in seg:
+        total += v
+        knots.append(total)
+    knots = [k / total for k in knots]
+    if len(rows) <= 4:
+        return W, _Cubic(knots, rows), knots
+    return W, CubicSpline(np.array(knots), W, axis=0, bc_type="not-a-knot"), knots
+
+
+def path_values(path: JointSpline, s: list[float]) -> np.ndarray:
+    """``path(s)`` (len(s), n) for a list of parameters: what the FK check of a straight line
+    samples (:class:`_Cubic`'s by Horner's rule directly, the same operations as its ``path(s)``)."""
+    if isinstance(path, _Cubic):
+        a, b, c, d = path.c[:, 0]
+        col = np.array(s)[:, None]
+        return ((a * col + b) * col + c) * col + d
+    return path(np.array(s))
 
 
 def derivative_bounds(path: JointSpline) -> tuple[list[float], list[float]]:

@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from robocfg.motion.minjerk_path import JointSpline, joint_path, joint_path_knots
+from robocfg.motion.minjerk_path import JointSpline, joint_path, joint_path_knots, path_values
 
 if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
@@ -89,22 +89,22 @@ class _Line:
             raise _Unreachable(res, s)
         return res.q
 
-    def errors(self, path: JointSpline, knots: np.ndarray, S: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    def errors(self, path: JointSpline, knots: list[float], S: list[float]) -> tuple[list[float], list[bool]]:
         """Per piece i (between knots i and i+1 of ``path``, line fractions S[i]..S[i+1]): the
         largest distance (m) of the sampled EE from the segment, and whether a sample's
-        orientation is further from the goal's than allowed there (bool)."""
+        orientation is further from the goal's than allowed there."""
         samples: list[float] = []
         starts: list[int] = []
-        for (a, b), ka, kb in zip(pairwise(S), knots[:-1].tolist(), knots[1:].tolist(), strict=True):
+        for (a, b), ka, kb in zip(pairwise(S), knots[:-1], knots[1:], strict=True):
             m = max(MIN_SAMPLES, math.ceil(self.length * (b - a) / SAMPLE_STEP))
             starts.append(len(samples))
             samples += [ka + (kb - ka) * j / (m + 1) for j in range(1, m + 1)]
-        P, R = self.model.fk_poses(path(np.array(samples)), "ee")
+        poses = self.model.fk_pose_rows(path_values(path, samples), "ee")
         (x0, y0, z0), (ux, uy, uz), length, turn0 = self.p0, self.u, self.length, self.turn0
         g0, g1, g2, g3, g4, g5, g6, g7, g8 = self.R_goal
         dist: list[float] = []
         turned: list[bool] = []
-        for (px, py, pz), (r0, r1, r2, r3, r4, r5, r6, r7, r8) in zip(P.tolist(), R.reshape(-1, 9).tolist(), strict=True):
+        for (r0, r1, r2, px), (r3, r4, r5, py), (r6, r7, r8, pz), _ in poses:
             vx, vy, vz = px - x0, py - y0, pz - z0
             along = min(max(vx * ux + vy * uy + vz * uz, 0.0), length)  # the nearest point of the segment
             ox, oy, oz = vx - along * ux, vy - along * uy, vz - along * uz
@@ -114,8 +114,8 @@ class _Line:
             allowed = ANGLE_TOLERANCE + turn0 * max(1.0 - along / CARTESIAN_STEP, 0.0)
             turned.append(cos < math.cos(min(allowed, math.pi)))
         ends = [*starts[1:], len(dist)]
-        return (np.array([max(dist[a:b]) for a, b in zip(starts, ends, strict=True)]),
-                np.array([any(turned[a:b]) for a, b in zip(starts, ends, strict=True)]))
+        return ([max(dist[a:b]) for a, b in zip(starts, ends, strict=True)],
+                [any(turned[a:b]) for a, b in zip(starts, ends, strict=True)])
 
 
 def _angle(Ra: list[float], Rb: list[float]) -> float:
@@ -123,6 +123,15 @@ def _angle(Ra: list[float], Rb: list[float]) -> float:
     :func:`robocfg.geometry.rotation_angle` in Python floats."""
     c = (sum(a * b for a, b in zip(Ra, Rb, strict=True)) - 1.0) / 2.0
     return math.acos(min(max(c, -1.0), 1.0))
+
+
+def _linspace(a: float, b: float, num: int) -> list[float]:
+    """``np.linspace(a, b, num).tolist()`` (num ≥ 2, a < b) in Python floats: the same
+    ``i · step + a`` for each point and ``b`` itself last."""
+    step = (b - a) / (num - 1)
+    if step == 0.0:  # numpy's other branch (a denormal step): leave it to numpy
+        return np.linspace(a, b, num).tolist()
+    return [*(i * step + a for i in range(num - 1)), b]
 
 
 class _Unreachable(Exception):
@@ -153,7 +162,7 @@ def straight_line_path(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray
             return _first_guess(line, q0, fail)
         except (_Broken, _Unreachable):  # the old way: each point from the last (where it breaks, first)
             n = max(1, math.ceil(line.length / CARTESIAN_STEP - 1e-9))
-            S = np.linspace(0.0, 1.0, n + 1).tolist()
+            S = _linspace(0.0, 1.0, n + 1)
             Q = [q0]
             for s in S[1:]:
                 Q.append(line.solve(s, Q[-1]))
@@ -185,7 +194,7 @@ def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, J
     if S[-1] < 1.0:  # the rest: IK at its end from the last answer, then at the cuts between, seeded by interpolation
         a, qa = S[-1], Q[-1]
         n = max(1, math.ceil(line.length * (1.0 - a) / FIRST_PIECE - 1e-9))
-        cuts = np.linspace(a, 1.0, n + 1)[1:].tolist()
+        cuts = _linspace(a, 1.0, n + 1)[1:]
         q1 = line.solve(1.0, qa)
         for s in cuts[:-1]:
             Q.append(line.solve(s, qa + (s - a) / (1.0 - a) * (q1 - qa)))
@@ -204,7 +213,7 @@ def _refine(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarra
         if len(W_kept) != len(W):  # an answer repeated (the line does not move the joints): nothing to check
             return W, path
         dist, turned = line.errors(path, knots, S)
-        jumps = np.abs(np.diff(W, axis=0)).max(axis=1)
+        jumps = [max(abs(b - a) for a, b in zip(qa, qb, strict=True)) for qa, qb in pairwise(W.tolist())]
         new_S, new_Q, cut = [S[0]], [Q[0]], False
         for i in range(len(S) - 1):
             a, b = S[i], S[i + 1]
