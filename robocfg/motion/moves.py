@@ -265,7 +265,9 @@ class ArmMover:
         g.close()
         last = g.width()  # None: no fingers whose stillness could be awaited (suction)
         still = 0.0
-        while not (g.is_grasping(body) and (last is None or still >= 0.1)):
+        # the cheap test first: the contact query (a pure read of the last step's contacts) only
+        # once the width has been still long enough, where its answer decides
+        while not ((last is None or still >= 0.1) and g.is_grasping(body)):
             self.step(SETTLE_POLL)
             w = g.width()
             if w is not None and last is not None:

@@ -176,8 +176,9 @@ class _StateMachine(GraspChoice):
         shape and the height the task gave) and return its rotation (3x3)."""
         pos, quat = self.world.body_pose(self.obj)
         R = quat_to_matrix(quat)
-        self.support_z = float(pos[2]) - self.shape.below_origin(R)  # as the task put it, if nothing is below
-        z = self._support_height(pos[:2]) + self.shape.below_origin(R)
+        below = self.shape.below_origin(R)
+        self.support_z = float(pos[2]) - below  # as the task put it, if nothing is below
+        z = self._support_height(pos[:2]) + below
         if abs(z - pos[2]) > REST_TOLERANCE:
             self.world.set_body_pose(self.obj, [pos[0], pos[1], z], quat)
         return R
@@ -215,7 +216,7 @@ class _StateMachine(GraspChoice):
         self.gripper.open()
         now = last = self.gripper.fraction()  # the opening measured once per poll (no joint moves between)
         still = 0.0
-        while self._held() or now < 0.9:
+        while now < 0.9 or self._held():  # the contact query (a pure read) only once the fingers are 90 % open
             if self.world.t - t0 > self.params.timeouts.release:
                 raise MoveFailed("release", "the object did not come free")
             self.mover.step(SETTLE_POLL)
