@@ -26,6 +26,9 @@ if TYPE_CHECKING:
 
 CLOSING_SAMPLES = 9  # openings measured from open to closed (a Robotiq's pads move ≈ 10 mm between samples)
 CLOSING_TOLERANCE = 0.005  # m: a sample this much narrower than the grasp width still counts as reached
+# m: added to a link box's bounds in the grasp frame before the object's bounds are compared with
+# them (linkage_hits): far beyond the rounding of the box test's few operations on values < 10 m
+BOUNDS_SLACK = 1e-6
 
 
 @dataclass(frozen=True)
@@ -38,6 +41,15 @@ class GripperSample:
     lo: np.ndarray
     hi: np.ndarray
     obbs: tuple[OrientedBox, ...]
+
+    def bounds(self, margin: float) -> list[tuple[list[float], list[float]]]:
+        """Per oriented box, its bounds in the grasp frame grown by ``margin`` (see
+        :func:`_grasp_frame_bounds`), computed once per margin (the sample is measured once a world)."""
+        kept: dict[float, list[tuple[list[float], list[float]]]] = self.__dict__.setdefault("_bounds", {})
+        out = kept.get(margin)
+        if out is None:
+            out = kept[margin] = [_grasp_frame_bounds(obb, margin) for obb in self.obbs]
+        return out
 
 
 @dataclass(frozen=True)
@@ -54,12 +66,25 @@ class GripperBoxes:
 
     def linkage_hits(self, points_g: np.ndarray, width: float, margin: float) -> bool:
         """True if a non-finger link, at any measured opening down to ``width`` (m), has one of
-        ``points_g`` (N, 3, grasp frame) inside its oriented box grown by ``margin``."""
+        ``points_g`` (N, 3, grasp frame) inside its oriented box grown by ``margin``.
+
+        A link box whose axis-aligned bounds in the grasp frame (grown by ``margin`` and
+        ``BOUNDS_SLACK``) do not meet the points' bounds holds none of them: it is passed over
+        without testing the points one by one (the answer is the same; a box the object is far
+        from costs a few float comparisons instead of the points' transform)."""
+        cloud: tuple[list[float], list[float]] | None = None
         for s in self.samples:
             if s.gap < width:
                 continue
-            for R, t, lo, hi, touches in s.obbs:
+            for i, (R, t, lo, hi, touches) in enumerate(s.obbs):
                 if touches:
+                    continue
+                if cloud is None:
+                    if len(points_g) == 0:
+                        return False
+                    cloud = points_g.min(axis=0).tolist(), points_g.max(axis=0).tolist()
+                (blo, bhi), (clo, chi) = s.bounds(margin)[i], cloud
+                if any(chi[k] < blo[k] or clo[k] > bhi[k] for k in range(3)):
                     continue
                 local = (points_g - t) @ R
                 if np.any(np.all((local >= lo - margin) & (local <= hi + margin), axis=1)):
@@ -91,6 +116,19 @@ class GripperBoxes:
     def finger_height(self) -> tuple[float, float]:
         """z range (m) shared by the fingers (their width across the closing direction)."""
         return float(self.lo[self.finger, 2].max()), float(self.hi[self.finger, 2].min())
+
+
+def _grasp_frame_bounds(obb: OrientedBox, margin: float) -> tuple[list[float], list[float]]:
+    """(min corner, max corner) (m, grasp frame) bounding the oriented box ``obb`` grown by
+    ``margin``, widened by ``BOUNDS_SLACK``: a point the box test (``(p − t)·R`` within
+    ``[lo − margin, hi + margin]``) finds inside lies within them whatever the rounding, so a
+    point set outside them has no point in the box."""
+    R, t, lo, hi = (np.asarray(a, dtype=float).tolist() for a in obb[:4])
+    mid = [(a + b) / 2 for a, b in zip(lo, hi, strict=True)]
+    half = [(b - a) / 2 + margin + BOUNDS_SLACK for a, b in zip(lo, hi, strict=True)]
+    centre = [t[k] + sum(R[k][j] * mid[j] for j in range(3)) for k in range(3)]
+    ext = [sum(abs(R[k][j]) * half[j] for j in range(3)) + BOUNDS_SLACK for k in range(3)]
+    return [c - e for c, e in zip(centre, ext, strict=True)], [c + e for c, e in zip(centre, ext, strict=True)]
 
 
 def measure_gripper(robot: RobotHandle, arm: ArmHandle) -> GripperBoxes:
