@@ -108,10 +108,11 @@ def iter_top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> Iterator[list
     for order, a in enumerate(angles):
         d = np.array([math.cos(a), math.sin(a)])
         proj = rel @ d
-        width = float(proj.max() - proj.min())
+        hi, lo = proj.max(), proj.min()
+        width = float(hi - lo)
         if width > w_max:
             continue
-        mid = float(proj.max() + proj.min()) / 2
+        mid = float(hi + lo) / 2
         options.append((round(width / SAME_WIDTH), order, a, width, mid))
     fixed = _HeightCheck.of(obj) if options else None
     for _, _, a, width, mid in sorted(options):

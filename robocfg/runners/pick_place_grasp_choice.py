@@ -62,8 +62,7 @@ class GraspChoice:
             """(joint travel in rad, the straight lines down to check: (start q, goal EE pose));
             inf travel: unreachable."""
             shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
-            T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
-            T_grasp = ee_pose_from_grasp(g, self.cfg)
+            T_pre, T_grasp = self._grasp_poses(g)
             cost, q, lines = 0.0, q0, []
             for T, T_down in ((T_pre, T_grasp), (shifted(T_pre, shift), shifted(T_grasp, shift))):
                 res = self.mover.ik(T, q)
@@ -73,12 +72,13 @@ class GraspChoice:
                 lines.append((q, T_down))
             return cost, lines
 
+        R_ee_graspnet = np.asarray(self.cfg.R_ee_graspnet)
         for group in self._iter_grasp_groups(lying):  # searched one at a time: usually the first will do
             if first is None:
                 first = group
                 R_now = self.arm.ee_pose()[:3, :3]
                 q0 = self.arm.joint_positions()
-            cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ np.asarray(self.cfg.R_ee_graspnet)))
+            cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ R_ee_graspnet))
             reached = [reach(g) for g in cands]
             order = sorted((i for i, (cost, _) in enumerate(reached) if cost < math.inf), key=lambda i: (reached[i][0], i))
             if not order:
@@ -93,6 +93,20 @@ class GraspChoice:
         if first is None:
             raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
         return first[0]
+
+    def _grasp_poses(self, g: Grasp) -> tuple[np.ndarray, np.ndarray]:
+        """(EE pose at the pre-grasp stand-off, EE pose at the grasp) of ``g`` (4x4, world,
+        read-only): computed once an episode per grasp (the choice weighs them and the pick then
+        moves to the chosen grasp's)."""
+        kept: dict[int, tuple[Grasp, np.ndarray, np.ndarray]] = self.__dict__.setdefault("_poses_of_grasps", {})
+        entry = kept.get(id(g))
+        if entry is None or entry[0] is not g:
+            T_pre = ee_pose_from_grasp(g, self.cfg, standoff=self.params.above_height)
+            T_grasp = ee_pose_from_grasp(g, self.cfg)
+            T_pre.setflags(write=False)
+            T_grasp.setflags(write=False)
+            entry = kept[id(g)] = (g, T_pre, T_grasp)  # the grasp kept with them: its id is not reused
+        return entry[1], entry[2]
 
     def _line_continuous(self, q: np.ndarray, T_goal: np.ndarray) -> bool:
         """Whether the straight EE line from FK(``q``) down to ``T_goal`` (the approach, or the

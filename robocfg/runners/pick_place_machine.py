@@ -23,7 +23,7 @@ from robocfg.checks.grip_force import grip_budget
 from robocfg.config.commands import PickPlaceParams
 from robocfg.geometry import quat_to_matrix
 from robocfg.grasp.object_grasp import LyingObject
-from robocfg.kinematics.frames import Grasp, ee_pose_from_grasp
+from robocfg.kinematics.frames import Grasp
 from robocfg.motion.moves import ArmMover, MoveFailed, grasp_hint
 from robocfg.runners.pick_place_grasp_choice import GraspChoice, shifted
 from robocfg.runners.pick_place_report import EpisodeResult, PhaseRecord
@@ -116,8 +116,7 @@ class _StateMachine(GraspChoice):
         """Phases pre_grasp → approach → grasp → lift with ``grasp``, checked that the object rose
         with the hand; returns the EE pose where the lift ended (4×4, world)."""
         p = self.params
-        T_grasp = ee_pose_from_grasp(grasp, self.cfg)
-        T_pre = ee_pose_from_grasp(grasp, self.cfg, standoff=p.above_height)
+        T_pre, T_grasp = (T.copy() for T in self._grasp_poses(grasp))  # as the grasp choice weighed them
         self.begin("pre_grasp", "move above the object")
         T_lift = shifted(T_grasp, [0, 0, p.lift_height])
         self._free_move(T_pre, lines=(T_grasp, T_lift))
