@@ -50,6 +50,21 @@ def test_pause_raises_the_threshold_resume_freezes_restore_thaws(restored: None,
     assert gc.get_freeze_count() == 0
 
 
+@pytest.mark.skipif(not hasattr(sys, "setdlopenflags"), reason="no dlopen flags on this platform")
+@pytest.mark.parametrize("end", ["resume", "restore"])
+def test_pause_loads_extensions_with_lazy_binding_until_the_start_ends(restored: None, monkeypatch, end: str) -> None:
+    monkeypatch.setattr(collector, "nanobind_loaded", lambda: True)  # nothing frozen by this test
+    flags = sys.getdlopenflags()
+    gc.enable()
+    collector.pause()
+    try:
+        assert sys.getdlopenflags() & os.RTLD_LAZY and not sys.getdlopenflags() & os.RTLD_NOW
+        assert sys.getdlopenflags() & ~(os.RTLD_LAZY | os.RTLD_NOW) == flags & ~(os.RTLD_LAZY | os.RTLD_NOW)
+    finally:
+        getattr(collector, end)()
+    assert sys.getdlopenflags() == flags
+
+
 def test_nothing_is_frozen_where_a_nanobind_extension_is_loaded(restored: None, monkeypatch) -> None:
     monkeypatch.setattr(collector, "nanobind_loaded", lambda: True)
     frozen = gc.get_freeze_count()
@@ -92,9 +107,11 @@ def test_main_called_in_a_process_leaves_its_collector_as_it_was(restored: None)
 
 def test_a_disabled_collector_is_left_disabled(restored: None) -> None:
     gc.disable()
+    flags = sys.getdlopenflags()
     collector.pause()
     assert not collector.paused()
     assert not gc.isenabled()
+    assert sys.getdlopenflags() == flags  # a pause that does nothing changes nothing
 
 
 # a process that pauses first (as the command, a pool worker, a Ray actor and bench_startup's child
@@ -109,7 +126,8 @@ from robocfg.checks.task import load_task
 from robocfg.config import catalog
 from robocfg.engine import RunOptions, open_session
 session = open_session(load_task(catalog.find("tasks", "pick_place")), RunOptions(seed=0, episodes=1))
-print("CHILD", len(made), gc.get_threshold(), collector.paused(), gc.get_freeze_count() > 10000)
+print("CHILD", len(made), gc.get_threshold(), collector.paused(), gc.get_freeze_count() > 10000,
+      sys.getdlopenflags() == __import__("os").RTLD_NOW)
 session.close()
 """
 
@@ -119,4 +137,4 @@ def test_a_paused_process_collects_nothing_until_its_world_is_built_then_as_befo
     out = subprocess.run([sys.executable, "-c", _CHILD], cwd=ROOT, env=env, capture_output=True, text=True)
     assert out.returncode == 0, out.stderr[-2000:]
     line = next(ln for ln in out.stdout.splitlines() if ln.startswith("CHILD"))
-    assert line == "CHILD 0 (700, 10, 10) False True"  # no collection; CPython's default thresholds back
+    assert line == "CHILD 0 (700, 10, 10) False True True"  # no collection; CPython's default thresholds and dlopen flags back
