@@ -72,6 +72,7 @@ BUCKETS = (  # (module, class or None for a module function, function, label); e
     ("robocfg.sim.world", "World", "step", "step loop"),
     ("robocfg.sim.world", "World", "periodic_check", "step loop"),
     ("robocfg.motion.moves", "ArmMover", "straight_path", "straight lines (IK aside)"),
+    ("robocfg.motion.moves", "ArmMover", "straight_end", "straight lines (IK aside)"),
     ("robocfg.motion.moves", "ArmMover", "move", "move set-up"),
     ("robocfg.motion.moves", "ArmMover", "play", "move set-up"),
     ("robocfg.motion.moves", "ArmMover", "_stretch", "move set-up"),

@@ -155,3 +155,42 @@ def test_linspace_in_floats_is_numpys():
         a, num = float(rng.uniform(0.0, 0.99)), int(rng.integers(2, 40))
         assert sl._linspace(a, 1.0, num) == np.linspace(a, 1.0, num).tolist()
     assert sl._linspace(0.0, 1.0, 2) == [0.0, 1.0]
+
+
+@pytest.mark.parametrize("delta", [(0.0, 0.0, -0.12), (0.25, -0.1, 0.05), (0.0, 0.0, 0.004), (-0.05, 0.3, -0.15)])
+@pytest.mark.parametrize("turn", [0.0, 0.03])
+def test_straight_end_is_the_lines_last_waypoint_with_fewer_solves(kin, delta, turn, monkeypatch):
+    """What a joint-space move compares with its direct answer: the end the line's first guess
+    solves (from the point 3 cm along when the start is turned from the goal, rad), the same bits
+    as the checked line's last waypoint, without the inner cuts' solves."""
+    from robocfg.geometry.rotation import axis_angle_matrix
+
+    R = axis_angle_matrix([0.0, 0.0, 1.0], turn) @ DOWN
+    q_start = kin.ik(np.block([[R, np.array([[0.45], [0.05], [0.35]])], [np.zeros((1, 3)), 1.0]]),
+                     seed_q=kin.home, frame="ee").q
+    T_goal = np.block([[DOWN, (kin.fk(q_start, "ee")[:3, 3] + delta)[:, None]], [np.zeros((1, 3)), 1.0]])
+    mover, calls, counted = _counting_mover(kin)
+    monkeypatch.setattr(kin, "ik", counted)
+    W = mover.straight_waypoints(q_start, T_goal)
+    line_calls = len(calls)
+    calls.clear()
+    q_end = mover.straight_end(q_start, T_goal)
+    assert q_end.tobytes() == W[-1].tobytes()
+    assert len(calls) == (2 if turn and np.linalg.norm(delta) > sl.CARTESIAN_STEP else 1)
+    assert len(calls) <= line_calls
+
+
+def test_straight_end_fails_where_the_lines_first_points_fail():
+    """Unreachable ends are named as the line names them; where the checked line breaks further
+    on (the branch case), the end is still an answer of the goal (a joint-space goal needs no
+    line between)."""
+    model = KinematicModel.from_robot(load_robot(PANDA))
+    bound_ik_by_iterations(model)
+    mover = ArmMover(None, None, model, None)  # type: ignore[arg-type]
+    T, T_down, q0 = panda_branch_case()
+    nearest = mover.solve(T, q0)
+    assert np.allclose(model.fk(mover.straight_end(nearest, T_down), "ee"), T_down, atol=1e-4)
+    T_far = T.copy()
+    T_far[:3, 3] = [1.6, -0.3, 0.25]
+    with pytest.raises(MoveFailed, match=r"unreachable at 100% of the straight line"):
+        mover.straight_end(nearest, T_far)

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robocfg.errors import PhaseFailed
+from robocfg.motion.joint_travel import joint_travel
 from robocfg.motion.pose_goal import PoseGoal
 
 if TYPE_CHECKING:
@@ -31,6 +32,7 @@ if TYPE_CHECKING:
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import JointLimits
     from robocfg.motion.minjerk_path import JointSpline
+    from robocfg.motion.straight_line import Fail, Solve, Unreachable
     from robocfg.motion.trajectory import Trajectory
     from robocfg.sim.gripper.base import Gripper
     from robocfg.sim.robot import ArmHandle
@@ -121,19 +123,29 @@ class ArmMover:
         """:meth:`straight_waypoints` and the joint path through them (for ``MinJerkPath``)."""
         from robocfg.motion.straight_line import straight_line_path
 
-        # straight to the solver, not through the answers remembered by self.ik: the points of a
-        # line are asked from the line's own seeds, never twice in an episode
+        return straight_line_path(self.model, q0, T_goal, *self._line_calls())
+
+    def straight_end(self, q0: np.ndarray, T_goal: np.ndarray) -> np.ndarray:
+        """Where a straight line from FK(q0) to ``T_goal`` would end, without building and checking
+        the line (:func:`~robocfg.motion.straight_line.straight_line_end`): a joint-space goal on q0's branch."""
+        from robocfg.motion.straight_line import straight_line_end
+
+        return straight_line_end(self.model, q0, T_goal, *self._line_calls())
+
+    def _line_calls(self) -> tuple[Solve, Fail, Unreachable]:
+        """(IK, failure, unreachable) for the straight-line functions. IK goes straight to the
+        solver, not through the answers remembered by self.ik: the points of a line are asked
+        from the line's own seeds, never twice in an episode."""
         ik, budget = self.model.ik, self.ik_budget
-        return straight_line_path(self.model, q0, T_goal,
-                                  lambda T, seed: ik(T, seed_q=seed, frame="ee", time_budget=budget),
-                                  lambda reason: MoveFailed(self.phase, reason), self._unreachable)
+        return (lambda T, seed: ik(T, seed_q=seed, frame="ee", time_budget=budget),
+                lambda reason: MoveFailed(self.phase, reason), self._unreachable)
 
     def move(self, T_goal: np.ndarray, straight: bool, q_goal: np.ndarray | None = None,
              check: Callable[[], str | None] | None = None) -> None:
         """Go to ``T_goal``; ``q_goal`` (a known IK answer) skips the IK of a joint-space move.
-        A joint-space move takes, of the direct IK answer and the end of a continuous straight
-        line, the one with less joint travel (IK may land on a far branch). ``check()`` runs at
-        the end and returns a failure reason or None."""
+        A joint-space move takes, of the direct IK answer and where a straight line would end
+        (:meth:`straight_end`), the one with less joint travel (IK may land on a far branch).
+        ``check()`` runs at the end and returns a failure reason or None."""
         from robocfg.motion.minjerk_path import MinJerkPath
 
         q0 = self.arm.joint_positions()
@@ -144,15 +156,15 @@ class ArmMover:
         else:
             if q_goal is None:
                 q_goal = self.solve(T_goal, q0)
-                if np.max(np.abs(q_goal - q0)) > DIRECT_TRAVEL_CHECK:
+                if joint_travel(q0, q_goal) > DIRECT_TRAVEL_CHECK:
                     try:
-                        q_line = self.straight_waypoints(q0, T_goal)[-1]
-                        if np.max(np.abs(q_line - q0)) < np.max(np.abs(q_goal - q0)):
+                        q_line = self.straight_end(q0, T_goal)
+                        if joint_travel(q0, q_line) < joint_travel(q0, q_goal):
                             q_goal = q_line
                     except MoveFailed:
                         pass
             W = np.asarray([q0, q_goal])
-        if np.max(np.abs(W[-1] - W[0])) >= 1e-6:
+        if joint_travel(W[0], W[-1]) >= 1e-6:
             traj = MinJerkPath(W, self.limits, path=path)
             if self.max_acceleration is not None:
                 traj.duration *= self._stretch(traj, self.max_acceleration)

@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from robocfg.motion.joint_travel import joint_travel
 from robocfg.motion.minjerk_path import JointSpline, joint_path, joint_path_knots, path_values
 
 if TYPE_CHECKING:
@@ -55,6 +56,7 @@ MIN_SAMPLES = 3
 POSITION_TOLERANCE = 5e-5  # m: the played path's EE from the segment
 ANGLE_TOLERANCE = math.radians(0.01)  # rad: its orientation from the goal's (past the first CARTESIAN_STEP)
 GIVE_UP_DISTANCE = 1e-3  # m: a MIN_PIECE piece further than this from the line breaks the line
+_COS_TOLERANCE = math.cos(ANGLE_TOLERANCE)
 
 Solve = Callable[[np.ndarray, np.ndarray], "IKResult"]  # (world_T_ee, seed) -> IK answer
 Fail = Callable[[str], Exception]  # reason -> the error to raise
@@ -106,13 +108,20 @@ class _Line:
         turned: list[bool] = []
         for (r0, r1, r2, px), (r3, r4, r5, py), (r6, r7, r8, pz), _ in poses:
             vx, vy, vz = px - x0, py - y0, pz - z0
-            along = min(max(vx * ux + vy * uy + vz * uz, 0.0), length)  # the nearest point of the segment
+            along = vx * ux + vy * uy + vz * uz  # the nearest point of the segment: clipped to [0, length]
+            if along < 0.0:
+                along = 0.0
+            elif along > length:
+                along = length
             ox, oy, oz = vx - along * ux, vy - along * uy, vz - along * uz
             dist.append(math.sqrt(ox * ox + oy * oy + oz * oz))
             # cos of the angle to the goal's orientation, (trace(goal_R_ee) - 1) / 2, against the allowed angle's
             cos = (r0 * g0 + r1 * g1 + r2 * g2 + r3 * g3 + r4 * g4 + r5 * g5 + r6 * g6 + r7 * g7 + r8 * g8 - 1.0) / 2.0
-            allowed = ANGLE_TOLERANCE + turn0 * max(1.0 - along / CARTESIAN_STEP, 0.0)
-            turned.append(cos < math.cos(min(allowed, math.pi)))
+            if along < CARTESIAN_STEP:  # the orientation may still be turning from FK(q0)'s
+                allowed = ANGLE_TOLERANCE + turn0 * (1.0 - along / CARTESIAN_STEP)
+                turned.append(cos < math.cos(min(allowed, math.pi)))
+            else:
+                turned.append(cos < _COS_TOLERANCE)
         ends = [*starts[1:], len(dist)]
         return ([max(dist[a:b]) for a, b in zip(starts, ends, strict=True)],
                 [any(turned[a:b]) for a, b in zip(starts, ends, strict=True)])
@@ -178,19 +187,11 @@ def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, J
     for the old way to try, ``fail`` where the old way would have failed the same."""
     if line.length < MIN_PIECE:  # too short to cut: the goal's answer, checked for a jump
         q1 = line.solve(1.0, q0)
-        jump = float(np.max(np.abs(q1 - q0)))
+        jump = joint_travel(q0, q1)
         if jump > MAX_JOINT_JUMP:
             raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at 100%)")
         return np.asarray([q0, q1]), joint_path(np.asarray([q0, q1]))[1]
-    S, Q = [0.0], [q0]
-    if line.turn0 > ANGLE_TOLERANCE:  # the orientation turns within the first CARTESIAN_STEP: that point first, from q0
-        s1 = min(1.0, CARTESIAN_STEP / line.length)
-        q = line.solve(s1, q0)
-        jump = float(np.max(np.abs(q - q0)))
-        if jump > MAX_JOINT_JUMP:  # as the old way fails at its first point
-            raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at {s1:.0%})")
-        S.append(s1)
-        Q.append(q)
+    S, Q = _start(line, q0, fail)
     if S[-1] < 1.0:  # the rest: IK at its end from the last answer, then at the cuts between, seeded by interpolation
         a, qa = S[-1], Q[-1]
         n = max(1, math.ceil(line.length * (1.0 - a) / FIRST_PIECE - 1e-9))
@@ -201,6 +202,44 @@ def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, J
         S += cuts
         Q.append(q1)
     return _refine(line, S, Q)
+
+
+def _start(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[list[float], list[np.ndarray]]:
+    """The first guess's first points (line fractions, joints): q0, and where the orientation
+    turns within the first CARTESIAN_STEP, the answer there, from q0 (``fail`` on a jump there)."""
+    S, Q = [0.0], [q0]
+    if line.turn0 > ANGLE_TOLERANCE:  # the orientation turns within the first CARTESIAN_STEP: that point first, from q0
+        s1 = min(1.0, CARTESIAN_STEP / line.length)
+        q = line.solve(s1, q0)
+        jump = joint_travel(q0, q)
+        if jump > MAX_JOINT_JUMP:  # as the old way fails at its first point
+            raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at {s1:.0%})")
+        S.append(s1)
+        Q.append(q)
+    return S, Q
+
+
+def straight_line_end(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray, ik: Solve,
+                      fail: Fail, unreachable: Unreachable) -> np.ndarray:
+    """The joints the first guess of :func:`straight_line_path` ends at, without its inner cuts
+    and FK check: a joint-space move's candidate goal on q0's branch (its path is played in joint
+    space, not along the line). The same answer as the line's last waypoint whenever the first
+    guess holds; ``fail`` and ``unreachable`` where its first points fail."""
+    q0 = np.asarray(q0, dtype=float)
+    line = _Line(model, q0, T_goal, ik)
+    try:
+        if line.length < MIN_PIECE:
+            S, Q = [0.0], [q0]
+        else:
+            S, Q = _start(line, q0, fail)
+        if S[-1] >= 1.0:
+            return Q[-1]
+        q1 = line.solve(1.0, Q[-1])
+    except _Unreachable as exc:
+        raise unreachable(exc.res, f" at {exc.s:.0%} of the straight line") from None
+    if line.length < MIN_PIECE and (jump := joint_travel(q0, q1)) > MAX_JOINT_JUMP:
+        raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at 100%)")
+    return q1
 
 
 def _refine(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarray, JointSpline]:
