@@ -11,6 +11,9 @@ follow-target controller that avoids the scene, with the same checks). Failures 
 IK is bounded by an iteration budget (``bound_ik_by_iterations``) rather than wall-clock time, so
 the same seed gives the same answers whatever the machine load; ``ik_budget`` (s) bounds a model
 that has no iteration budget only.
+
+About 310 lines: one class whose moves, polls and gripper waits share the mover's state; the lines,
+the timing and the held-load bound live in their own modules.
 """
 
 from __future__ import annotations
