@@ -12,7 +12,7 @@ IK is bounded by an iteration budget (``bound_ik_by_iterations``) rather than wa
 the same seed gives the same answers whatever the machine load; ``ik_budget`` (s) bounds a model
 that has no iteration budget only.
 
-About 310 lines: one class whose moves, polls and gripper waits share the mover's state; the lines,
+Over 300 lines: one class whose moves, polls and gripper waits share the mover's state; the lines,
 the timing and the held-load bound live in their own modules.
 """
 
