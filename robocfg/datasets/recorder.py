@@ -61,6 +61,10 @@ class EpisodeRecorder:
         self.replay_actions = replay_actions
         grip = list(arm.robot.checked.gripper_joints(arm.config)) if arm.gripper is not None else []
         self._joint_names = list(arm.joints) + grip
+        # where each recorded joint sits among the robot's movable joints (the divergence check's
+        # read, reused by a frame at the check's step); None: a recorded joint is not among them
+        movable = arm.robot.movable_joints
+        self._in_check = [movable.index(n) for n in self._joint_names] if set(self._joint_names) <= set(movable) else None
         self._base_inv = np.linalg.inv(world.robot.base_pose())
         self._phase_index = {p: i for i, p in enumerate(layout.phases)}
         self._hooked = False
@@ -126,10 +130,20 @@ class EpisodeRecorder:
             a = self.gate.latch(first=first)
         self.actions.append(a)
         r, arm = self.arm.robot, self.arm
-        q, qd = r.joint_states(self._joint_names)
+        # On a check's step (every frame at 20 Hz, and every frame off the grid, checked above) the
+        # joints were just read by the check: the same values, without two more state queries.
+        where = self._in_check
+        read = None if first or where is None else w.checked_joint_states(r)
+        if read is None or where is None:
+            q, qd = r.joint_states(self._joint_names)
+            opening = arm.gripper.fraction() if arm.gripper is not None else 0.0
+        else:
+            states = [read[i] for i in where]
+            q, qd = [s[0] for s in states], [s[1] for s in states]
+            opening = arm.gripper.fraction_at(q[len(arm.joints):]) if arm.gripper is not None else 0.0
         self.q.append(q)
         self.qd.append(qd)
-        self.opening.append(arm.gripper.fraction() if arm.gripper is not None else 0.0)
+        self.opening.append(opening)
         self.ee.append(r.link_position_quat(arm.config.ee_link))
         for bid in self.objs:
             self.obj_pose.append(self.world.body_pose_tuple(bid))

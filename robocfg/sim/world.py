@@ -103,6 +103,8 @@ class World(SceneQueries):
         self._dynamic: list[int] = []
         # (robot, body id, movable joint indices) of each robot with movable joints: what _check reads
         self._joint_reads: list[tuple[RobotHandle, int, list[int]]] = []
+        # what the last check read: (world.steps then, each _joint_reads entry's getJointStates tuples)
+        self._checked: tuple[int, list[tuple]] = (-1, [])
         self._grippers: list[Gripper] = []
         if self.gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise RobocfgError("--gui needs a display (DISPLAY is not set); run headless without --gui, "
@@ -345,6 +347,7 @@ class World(SceneQueries):
         restored joint positions and every gripper reset open."""
         p.restoreState(stateId=state, physicsClientId=self.client)
         self.t, self.steps = 0.0, 0
+        self._checked = (-1, [])
         for robot in self.robots:
             for arm in robot.arms.values():
                 arm.command(arm.joint_positions())
@@ -363,8 +366,11 @@ class World(SceneQueries):
         # unpacked in the loop's own assignment (no per-joint subscript); ≈ 15 % less CPU a
         # check than reading them through each robot's attributes (in situ, paired)
         c, vmax, states = self.client, self.max_joint_velocity, p.getJointStates
+        read: list[tuple] = []
+        self._checked = (self.steps, read)  # for a dataset frame at this step (checked_joint_states)
         for r, body, idx in self._joint_reads:
             joints = states(body, idx, c)
+            read.append(joints)
             for _, v, _, _ in joints:
                 if not -vmax <= v <= vmax:  # also catches NaN
                     self._diverged_joint(r, [js[1] for js in joints])
@@ -375,6 +381,21 @@ class World(SceneQueries):
                 if not x * x + y * y + z * z <= vbody2:  # also catches NaN (and inf)
                     name = next((k for k, v in self.bodies.items() if v == bid), str(bid))
                     raise PhysicsDiverged(self.t, f"body {name!r} speed {math.sqrt(x * x + y * y + z * z):.3g} m/s")
+
+    def checked_joint_states(self, robot: RobotHandle) -> tuple | None:
+        """PyBullet's ``getJointStates`` tuples of ``robot``'s movable joints (DOF order) as the
+        divergence check read them at this very step, or None when no check ran since the last
+        physics step (or since a restore). A dataset frame taken right after the check (the check
+        comes first on every frame's step) reads the same values from them instead of asking
+        PyBullet again; nothing between the two moves a joint (the step's hooks only read, and a
+        teleport never happens between a step's check and its frame)."""
+        step, read = self._checked
+        if step != self.steps:
+            return None
+        for (r, _, _), joints in zip(self._joint_reads, read, strict=False):
+            if r is robot:
+                return joints
+        return None
 
     def _diverged_joint(self, robot: RobotHandle, velocities: list[float]) -> None:
         """Raise PhysicsDiverged naming ``robot``'s first joint whose velocity is out of bounds."""

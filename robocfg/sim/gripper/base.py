@@ -77,6 +77,12 @@ class Gripper(ABC):
         """Measured opening, 0 (closed) to 1 (open)."""
         raise NotImplementedError
 
+    def fraction_at(self, q: list[float]) -> float:
+        """The opening measured when the gripper's driven joints (``gripper_joints``, in order)
+        stand at ``q``, for a gripper that measures it from them (a parallel one); the others
+        measure it their own way (:meth:`fraction`)."""
+        return self.fraction()
+
     def width(self) -> float | None:
         """Measured finger gap (m), or None for a gripper without fingers."""
         return None

@@ -167,11 +167,17 @@ class ParallelGripper(Gripper):
         if self._fraction_terms is None:
             return float(np.mean((self.robot.joint_positions(self.joints) - self.q_closed) / (self.q_open - self.q_closed)))
         states = p.getJointStates(self.robot.body_id, self._joint_indices, physicsClientId=self.client)
-        if len(states) == 1:
-            ((q, *_),) = states
+        return self.fraction_at([s[0] for s in states])
+
+    def fraction_at(self, q: list[float]) -> float:
+        """The opening :meth:`fraction` measures when the driven joints (``gripper_joints``, in
+        order) stand at ``q`` (rad or m): the same operations on the same values."""
+        if self._fraction_terms is None:
+            return float(np.mean((np.array(q, dtype=float) - self.q_closed) / (self.q_open - self.q_closed)))
+        if len(q) == 1:
             ((lo, span),) = self._fraction_terms
-            return (q - lo) / span  # the mean of one value is itself
-        (qa, *_), (qb, *_) = states
+            return (q[0] - lo) / span  # the mean of one value is itself
+        qa, qb = q
         (la, sa), (lb, sb) = self._fraction_terms
         return ((qa - la) / sa + (qb - lb) / sb) / 2
 
