@@ -27,6 +27,29 @@ def test_positions_velocities_are_evaluates_bits(k):
     assert np.allclose(q[-1], W[-1], atol=1e-12) and np.abs(qd).max() > 0.1  # it moved, and ends at the goal
 
 
+@pytest.mark.parametrize("k", [2, 3, 4, 7])
+@pytest.mark.parametrize("dt", [1 / 240, 0.002, 0.01])
+def test_step_targets_are_positions_velocities_bits(k, dt):
+    """What ArmMover.play sends (the step times k·dt, the last ones past the end) is
+    positions_velocities' answer bit for bit, also with a stretched duration (a held load), and
+    evaluate's (q, qd)."""
+    import math
+
+    rng = np.random.default_rng(10 + k)
+    limits = JointLimits(names=tuple("abcdefg"), lower=np.full(7, -4.0), upper=np.full(7, 4.0),
+                         velocity=np.full(7, 2.0), acceleration=np.full(7, 6.0))
+    for trial in range(10):
+        path = MinJerkPath(np.cumsum(rng.normal(0.0, 0.2, (k, 7)), axis=0), limits)
+        if trial % 2:
+            path.duration *= 1.0 + rng.uniform(0.0, 0.7)
+        for n in (math.ceil(path.duration / dt - 1e-9), math.ceil(path.duration / dt) + 3, 1, 0):
+            t = np.arange(1, n + 1) * dt  # the second n: three steps past the end
+            got, ref = path.step_targets(dt, n), path.positions_velocities(t)
+            for a, b in zip(got, ref, strict=True):
+                assert a.shape == b.shape and a.tobytes() == b.tobytes() and a.strides == b.strides, (k, trial, n)
+            assert all(np.ascontiguousarray(a).tobytes() == b.tobytes() for a, b in zip(got, path.evaluate(t), strict=False))
+
+
 @pytest.mark.parametrize("k", [2, 3, 4, 5, 9])
 def test_duration_keeps_velocities_and_accelerations_within_the_limits(k):
     """The duration is a true bound: sampled densely (2000 instants), no joint's speed or

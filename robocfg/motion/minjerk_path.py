@@ -112,10 +112,20 @@ def _horner(coef: tuple[np.ndarray, ...], s: np.ndarray, nu: int, shape: tuple[i
     """The ``nu``-th derivative of a·s³ + b·s² + c·s + d (``coef`` = (a, b, c, d), broadcast
     against ``s``) by Horner's rule; ``shape``: the result's, for the constant derivatives."""
     a, b, c, d = coef
-    if nu == 0:
-        return ((a * s + b) * s + c) * s + d
-    if nu == 1:
-        return (3 * a * s + 2 * b) * s + c
+    if nu == 0:  # ((a·s + b)·s + c)·s + d, in place in the first product (of the full shape): the same operations
+        r = a * s
+        r += b
+        r *= s
+        r += c
+        r *= s
+        r += d
+        return r
+    if nu == 1:  # (3a·s + 2b)·s + c, likewise
+        r = 3 * a * s
+        r += 2 * b
+        r *= s
+        r += c
+        return r
     if nu == 2:
         return 6 * a * s + 2 * b
     return np.broadcast_to(6 * a if nu == 3 else 0 * a, shape).copy()
@@ -235,9 +245,23 @@ class MinJerkPath(Trajectory):
         """``evaluate(t)``'s (q, qd) by the same arithmetic, without the accelerations, evaluated a
         joint at a time along the times (:meth:`CubicSpline.derivatives_by_column`): they come
         back as the transposes of those (n, N) arrays (the same values; not C-ordered)."""
-        tau, tau2, s = self._law(t)
+        return self._positions_velocities(*self._law(t))
+
+    def step_targets(self, dt: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``positions_velocities(np.arange(1, n + 1) * dt)`` bit for bit: the times are ascending
+        and positive, so the clip to [0, duration] only lowers a tail past the end, found from the
+        end (one or two steps) instead of clipping every time."""
+        t, i = np.arange(1, n + 1) * dt, n
+        while i and t[i - 1] > self.duration:
+            i -= 1
+        t[i:] = self.duration
+        return self._positions_velocities(*self._law_within(t))
+
+    def _positions_velocities(self, tau: np.ndarray, tau2: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         sd = 30 * tau2 * (1 - tau) ** 2 / self.duration
         if s.ndim == 1:
+            if isinstance(self.spline, _Segment):  # q̇ = delta·ṡ: the same products, without the repeated delta
+                return self.spline.derivatives_by_column(s, (0,))[0].T, (self.spline.delta[:, None] * sd).T
             q, d1 = self.spline.derivatives_by_column(s, (0, 1))
             d1 *= sd  # d1 is new: scaled in place, each element as d1 * sd[:, None] scales it
             return q.T, d1.T
@@ -254,8 +278,13 @@ class MinJerkPath(Trajectory):
     def _law(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(τ, τ², s) of the min-jerk law at times ``t`` (s; clipped to [0, duration]), as
         ``_eval`` computes them (τ**2 is τ squared, once)."""
-        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
-        tau = np.clip(tt / self.duration, 0.0, 1.0)
+        return self._law_within(np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration))
+
+    def _law_within(self, tt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`_law` at times ``tt`` already within [0, duration] (no NaN aside): ``_eval``'s
+        clip of τ = tt / duration to [0, 1] changes nothing there (a correctly rounded quotient of
+        0 ≤ tt ≤ duration lies in [0, 1], with tt's sign of zero), so it is not made."""
+        tau = tt / self.duration
         tau2 = tau**2
         return tau, tau2, tau**3 * (10 - 15 * tau + 6 * tau2)
 

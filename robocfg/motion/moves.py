@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from copy import copy
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -28,13 +27,13 @@ import numpy as np
 
 from robocfg.errors import PhaseFailed
 from robocfg.motion.joint_travel import joint_travel
+from robocfg.motion.minjerk_path import JointSpline, MinJerkPath
 from robocfg.motion.pose_goal import PoseGoal
 
 if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import JointLimits
-    from robocfg.motion.minjerk_path import JointSpline
     from robocfg.motion.straight_line import Fail, Solve, Unreachable
     from robocfg.motion.trajectory import Trajectory
     from robocfg.sim.gripper.base import Gripper
@@ -103,7 +102,8 @@ class ArmMover:
         res = self._answers.get(key)
         if res is None:
             res = self._answers[key] = self.model.ik(T, seed_q=seed, frame="ee", time_budget=self.ik_budget)
-        out = copy(res)  # callers may keep or change their copy
+        out = object.__new__(type(res))  # copy.copy's shallow copy, without its reduce protocol:
+        out.__dict__.update(res.__dict__)  # callers may keep or change their copy
         out.q = res.q.copy()
         return out
 
@@ -149,8 +149,6 @@ class ArmMover:
         A joint-space move takes, of the direct IK answer and where a straight line would end
         (:meth:`straight_end`), the one with less joint travel (IK may land on a far branch).
         ``check()`` runs at the end and returns a failure reason or None."""
-        from robocfg.motion.minjerk_path import MinJerkPath
-
         q0 = self.arm.joint_positions()
         path = None
         if straight:
@@ -228,7 +226,7 @@ class ArmMover:
         statistics, so the per-step cost stays at one motor call)."""
         dt = self.world.dt
         n = math.ceil(traj.duration / dt - 1e-9)
-        q_ref, qd_ref = traj.positions_velocities(np.arange(1, n + 1) * dt)
+        q_ref, qd_ref = traj.step_targets(dt, n)
         self.world.play(self.arm, q_ref, qd_ref, self.on_step)
 
     def time_limit(self, planned: float | None, factor: float = 1.0) -> float:
@@ -243,8 +241,6 @@ class ArmMover:
     def _direct_duration(self, T_goal: np.ndarray) -> float | None:
         """Duration (s) of the direct joint-space move to ``T_goal`` (None when IK fails): the
         yardstick for a reactive move's time limit."""
-        from robocfg.motion.minjerk_path import MinJerkPath
-
         if self.timeout is not None:
             return None
         q0 = self.arm.joint_positions()

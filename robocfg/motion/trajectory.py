@@ -36,6 +36,11 @@ class Trajectory:
         derivatives."""
         return self.evaluate(t)[0]
 
+    def step_targets(self, dt: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``positions_velocities`` at the physics steps' times k·``dt`` (s), k = 1 … ``n``: what a
+        played move sends (a subclass may use that these times are ascending and positive)."""
+        return self.positions_velocities(np.arange(1, n + 1) * dt)
+
     def _eval(self, t: np.ndarray):  # pragma: no cover - abstract
         raise NotImplementedError
 
