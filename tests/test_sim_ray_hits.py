@@ -57,3 +57,52 @@ def test_the_first_hit_not_skipped_is_that_of_all_hits_and_stops_the_casts(clien
     casts.clear()
     q.ray_hits([0.01, 0.02, 5.0], [0.01, 0.02, -1.0])
     assert n_first < len(casts)  # the walk stopped at the first slab
+
+
+def _box(client: int, half: list[float], z: float, mass: float = 0.0) -> int:
+    return p.createMultiBody(mass, p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client),
+                             basePosition=[0, 0, z], physicsClientId=client)
+
+
+def test_jumping_skipped_bodies_finds_the_same_surface_with_fewer_casts(client, monkeypatch) -> None:
+    table = _box(client, [0.3, 0.3, 0.02], 0.68)  # top at 0.70
+    cube = _box(client, [0.025, 0.025, 0.025], 0.725, mass=0.1)  # resting on it
+    hand = [_box(client, [0.04, 0.04, 0.01], z) for z in (0.85, 0.95, 1.05)]  # an "arm" above
+    q = _Queries(client)
+    start, end = [0.003, 0.004, 5.0], [0.003, 0.004, -1.0]
+    casts = []
+    cast = p.rayTest
+    monkeypatch.setattr(p, "rayTest", lambda *a, **k: casts.append(a[0][2]) or cast(*a, **k))
+    walked = q.first_ray_hit(start, end, skip={cube, *hand})
+    n_walked = len(casts)
+    casts.clear()
+    jumped = q.first_ray_hit(start, end, skip={cube, *hand}, jump_skipped=True)
+    assert walked is not None and jumped is not None
+    assert walked.body == jumped.body == table
+    assert jumped.position[2] == pytest.approx(walked.position[2], abs=1e-9)
+    assert walked.position[2] == pytest.approx(0.70, abs=1e-3)
+    # the hand's boxes were jumped: the first cast starts above the cube (outside every box)
+    assert len(casts) < n_walked
+    assert 0.75 < casts[0] < 0.84
+    # the cube walked through as before (a hit on a skipped body is walked through)
+    assert q.first_ray_hit(start, end, skip=set(hand), jump_skipped=True).body == cube
+    # nothing but skipped bodies below: None
+    assert q.first_ray_hit(start, end, skip={table, cube, *hand}, jump_skipped=True) is None
+
+
+def test_a_body_not_skipped_above_the_skipped_ones_is_not_jumped(client) -> None:
+    table = _box(client, [0.3, 0.3, 0.02], 0.68)
+    hand = _box(client, [0.04, 0.04, 0.01], 0.85)
+    shelf = _box(client, [0.3, 0.3, 0.01], 1.2)  # above the hand: the first surface not skipped
+    q = _Queries(client)
+    start, end = [0.003, 0.004, 5.0], [0.003, 0.004, -1.0]
+    hit = q.first_ray_hit(start, end, skip={hand}, jump_skipped=True)
+    assert hit == q.first_ray_hit(start, end, skip={hand})  # nothing to jump: the same walk, bit for bit
+    assert hit is not None and hit.body == shelf
+    assert q.first_ray_hit(start, end, skip={hand, shelf}, jump_skipped=True).body == table
+    # a slanted ray: the same surface as the walk finds
+    slant = q.first_ray_hit([0.2, 0.1, 2.0], [-0.1, -0.05, 0.0], skip={hand, shelf}, jump_skipped=True)
+    assert slant is not None and slant.body == table
+    walked = q.first_ray_hit([0.2, 0.1, 2.0], [-0.1, -0.05, 0.0], skip={hand, shelf})
+    assert walked is not None and slant.position == pytest.approx(walked.position, abs=1e-9)
+    assert slant.position[2] == pytest.approx(0.70, abs=1e-6)

@@ -268,13 +268,15 @@ class _StateMachine(GraspChoice):
         if self.recorder is not None:
             self.recorder.maybe_capture()
 
-    def _support_height(self, xy: np.ndarray) -> float:
+    def _support_height(self, xy: np.ndarray, jump_skipped: bool = False) -> float:
         """Height (m) of the first surface below ``xy`` that is not the robot or the object. The ray
         is vertical, so its hits come highest first and the first one not skipped is the highest of
-        them: the casts stop there."""
+        them: the casts stop there. ``jump_skipped``: see
+        :meth:`~robocfg.sim.queries.SceneQueries.first_ray_hit` (the same surface; its height's
+        last bits may differ): only for heights that go to a check, never to what is simulated."""
         skip = {self.obj, *(r.body_id for r in self.world.robots)}
         z = 0.0 if self.world.task.config.scene.ground else -math.inf
-        hit = self.world.first_ray_hit([xy[0], xy[1], 5.0], [xy[0], xy[1], -1.0], skip)
+        hit = self.world.first_ray_hit([xy[0], xy[1], 5.0], [xy[0], xy[1], -1.0], skip, jump_skipped=jump_skipped)
         if hit is not None:
             z = max(z, hit.position[2])
         return z if math.isfinite(z) else self.support_z
@@ -285,7 +287,8 @@ class _StateMachine(GraspChoice):
         err = float(np.linalg.norm(pos[:2] - self.setup.place_xy))
         R = quat_to_matrix(quat)
         tilt = self.shape.tilt_deg(self.R0, R)  # as _tilt(quat)
-        rest_z = self._support_height(self.setup.place_xy) + self.shape.below_origin(R)
+        # the hand hovers above the place point: the ray starts below it (a 1 cm check)
+        rest_z = self._support_height(self.setup.place_xy, jump_skipped=True) + self.shape.below_origin(R)
         if err > p.success_tolerance:
             raise MoveFailed("place", f"object {err * 100:.1f} cm from the place point (tolerance {p.success_tolerance * 100:.1f} cm)")
         if tilt > p.max_tilt_deg:

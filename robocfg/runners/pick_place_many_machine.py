@@ -308,12 +308,12 @@ class ObjectMachine(_StateMachine):
         return top - (float(self.arm.tcp_pose()[2, 3]) - tip) + FINGER_CLEARANCE
 
     # ---- world helpers -----------------------------------------------------------------------
-    def _support_height(self, xy: np.ndarray) -> float:
+    def _support_height(self, xy: np.ndarray, jump_skipped: bool = False) -> float:
         """The place spot's board or floor (known exactly; a ray from above would find a shelf's
         top board), elsewhere the first surface below ``xy``."""
         if np.allclose(np.asarray(xy, float)[:2], self.setup.place_xy, atol=1e-9):
             return self.spot.z
-        return super()._support_height(xy)
+        return super()._support_height(xy, jump_skipped)
 
     def _on_step(self) -> None:
         super()._on_step()

@@ -14,6 +14,7 @@ import numpy as np
 import pybullet as p
 
 GUI_ERROR = p.error  # raised by GUI calls once the window is closed
+JUMP_CLEARANCE = 0.01  # m: a walk that jumps skipped bodies starts this far short of any other body's box
 
 
 @dataclass(frozen=True)
@@ -55,13 +56,73 @@ class SceneQueries:
         return list(self._ray_walk(start, end, max_hits))
 
     def first_ray_hit(self, start: Sequence[float], end: Sequence[float], skip: Collection[int] = (),
-                      max_hits: int = 16) -> RayHit | None:
+                      max_hits: int = 16, *, jump_skipped: bool = False) -> RayHit | None:
         """The first hit of :meth:`ray_hits` (same arguments) whose body is not in ``skip`` (None
-        when there is none): the casts stop there, those past it are not made."""
+        when there is none): the casts stop there, those past it are not made.
+
+        ``jump_skipped``: the walk starts past skipped bodies that the ray meets before any other
+        body's bounding box (:meth:`_past_skipped`), instead of casting through them (a robot arm
+        above the point: 3–4 casts a link). The same surface is found, but its hit point may
+        differ from a walk from ``start`` in the last bits (a cast's fraction depends on where it
+        starts): for answers that only go to a tolerance check."""
+        if jump_skipped and skip:
+            start = self._past_skipped(start, end, skip)
         for hit in self._ray_walk(start, end, max_hits):
             if hit.body not in skip:
                 return hit
         return None
+
+    def _past_skipped(self, start: Sequence[float], end: Sequence[float], skip: Collection[int]) -> Sequence[float]:
+        """Where a walk from ``start`` to ``end`` may start instead, having met only bodies in
+        ``skip`` before: a point of the segment :data:`JUMP_CLEARANCE` short of the first bounding
+        box (Bullet's, margin included: no surface lies outside it) of a body not in ``skip``, or
+        0.1 mm short of the skipped box it lies in (stepped back while it lies in one), so that the
+        cast starts outside every box, as one from ``start`` does. (A cast starting within about a
+        millimetre of a convex shape reports a hit *at its start*: 0.1 mm short of a table's box
+        gave a height 0.1 mm too high; a skipped body's such hit is walked through.) ``start``
+        itself when no skipped box lies wholly before that point (nothing to jump: the walk is then
+        the same, bit for bit)."""
+        a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+        length = float(np.linalg.norm(b - a))
+        if length == 0.0:
+            return start
+        d = ((b - a) / length).tolist()  # Python floats from here (numpy's per-element cost aside)
+        a0 = a.tolist()
+        c = self.client
+        pairs = p.getOverlappingObjects(np.minimum(a, b).tolist(), np.maximum(a, b).tolist(), physicsClientId=c)
+        skipped: list[tuple[float, float]] = []  # (entry, exit) along the ray (m from start)
+        first_other = length
+        moving = [(k, a0[k], d[k]) for k in range(3) if abs(d[k]) >= 1e-12]
+        still = [(k, a0[k]) for k in range(3) if abs(d[k]) < 1e-12]
+        for body, link in pairs or ():
+            lo, hi = p.getAABB(body, link, physicsClientId=c)
+            if any(not lo[k] <= ak <= hi[k] for k, ak in still):
+                continue
+            t0, t1 = 0.0, length  # the slab test: the segment's part inside the box
+            for k, ak, dk in moving:
+                u, v = (lo[k] - ak) / dk, (hi[k] - ak) / dk
+                if u > v:
+                    u, v = v, u
+                if u > t0:
+                    t0 = u
+                if v < t1:
+                    t1 = v
+            if t0 > t1:  # the segment misses this box
+                continue
+            if body in skip:
+                skipped.append((t0, t1))
+            else:
+                first_other = min(first_other, t0)
+        t = first_other - JUMP_CLEARANCE
+        moved = True
+        while moved:  # step back out of skipped boxes the point lies in
+            moved = False
+            for t0, t1 in skipped:
+                if t0 <= t <= t1:
+                    t, moved = t0 - 1e-4, True
+        if t <= 0.0 or not any(t1 < t for _, t1 in skipped):
+            return start
+        return [a0[k] + t * d[k] for k in range(3)]
 
     def _ray_walk(self, start: Sequence[float], end: Sequence[float], max_hits: int) -> Iterator[RayHit]:
         """:meth:`ray_hits`'s hits, nearest first, each cast made when the previous hit has been taken."""
