@@ -258,7 +258,11 @@ class MinJerkPath(Trajectory):
         return self._positions_velocities(*self._law_within(t))
 
     def _positions_velocities(self, tau: np.ndarray, tau2: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        sd = 30 * tau2 * (1 - tau) ** 2 / self.duration
+        sd = 30 * tau2  # 30τ²·(1 − τ)² / T, in place (x**2 is numpy's square)
+        b = 1 - tau
+        np.square(b, out=b)
+        sd *= b
+        sd /= self.duration
         if s.ndim == 1:
             if isinstance(self.spline, _Segment):  # q̇ = delta·ṡ: the same products, without the repeated delta
                 return self.spline.derivatives_by_column(s, (0,))[0].T, (self.spline.delta[:, None] * sd).T
@@ -286,7 +290,12 @@ class MinJerkPath(Trajectory):
         0 ≤ tt ≤ duration lies in [0, 1], with tt's sign of zero), so it is not made."""
         tau = tt / self.duration
         tau2 = tau**2
-        return tau, tau2, tau**3 * (10 - 15 * tau + 6 * tau2)
+        u = 15 * tau  # 10 − 15τ + 6τ², then τ³ times it: _eval's operations, in place in new arrays
+        np.subtract(10.0, u, out=u)
+        u += 6 * tau2
+        s = tau**3
+        s *= u
+        return tau, tau2, s
 
     def _eval(self, t):
         T = self.duration
