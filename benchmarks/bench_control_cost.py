@@ -63,6 +63,8 @@ BUCKETS = (  # (module, class or None for a module function, function, label); e
     ("robocfg.motion.trajectory", "Trajectory", "evaluate", "trajectory sampling"),
     ("robocfg.motion.minjerk_path", "MinJerkPath", "positions", "trajectory sampling"),
     ("robocfg.motion.trajectory", "Trajectory", "positions", "trajectory sampling"),
+    ("robocfg.motion.minjerk_path", "MinJerkPath", "step_targets", "trajectory sampling"),
+    ("robocfg.motion.trajectory", "Trajectory", "step_targets", "trajectory sampling"),
     ("robocfg.sim.gripper.parallel", "ParallelGripper", "update", "gripper update"),
     # the rest of the episode, by part ("other" is what none of these holds):
     ("robocfg.sim.playback", None, "_play_bare", "step loop"),
