@@ -106,3 +106,32 @@ def test_a_body_not_skipped_above_the_skipped_ones_is_not_jumped(client) -> None
     walked = q.first_ray_hit([0.2, 0.1, 2.0], [-0.1, -0.05, 0.0], skip={hand, shelf})
     assert walked is not None and slant.position == pytest.approx(walked.position, abs=1e-9)
     assert slant.position[2] == pytest.approx(0.70, abs=1e-6)
+
+
+def test_a_segments_floats_are_numpys_bits() -> None:
+    """_segment's start, end, length and direction equal numpy's (asarray, norm of the difference,
+    the difference over the length) bit for bit: vertical rays (the support queries', taken
+    without numpy), rays along x or y, slanted ones, numpy scalars as coordinates, a zero length."""
+    import numpy as np
+
+    from robocfg.sim.queries import _segment
+
+    rng = np.random.default_rng(3)
+    cases = []
+    for _ in range(3000):
+        a = rng.uniform(-3, 3, 3) * 10.0 ** rng.integers(-6, 3)
+        b = a.copy()
+        moving = rng.choice(3, size=int(rng.integers(1, 4)), replace=False)
+        b[moving] = rng.uniform(-6, 6, len(moving)) * 10.0 ** rng.integers(-8, 2)
+        cases.append((list(a), list(b)))  # numpy float64 coordinates, as the queries pass them
+    cases += [([0.1, 0.2, 5.0], [0.1, 0.2, -1.0]), ([0.0, -0.0, 1.0], [-0.0, 0.0, 1.0]), ([1.0, 2.0, 3.0], [1.0, 2.0, 3.0])]
+    for start, end in cases:
+        a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+        length = float(np.linalg.norm(b - a))
+        got = _segment(start, end)
+        assert got[0] == a.tolist() and got[1] == b.tolist()
+        assert got[2] == length
+        if length != 0.0:
+            assert np.array_equal(np.array(got[3]), (b - a) / length)
+    with pytest.raises(ValueError):
+        _segment([0.0, 0.0], [1.0, 1.0])

@@ -55,6 +55,10 @@ class BatchTiming:
         return sum(self.per_episode) / len(self.per_episode) if self.per_episode else 0.0
 
 
+def silent(_msg: str) -> None:
+    """The log of an episode whose lines nobody reads (see :meth:`EpisodeSession.log_for`)."""
+
+
 def episode_rng(seed: int, k: int) -> np.random.Generator:
     """The random stream of episode ``k`` of a run seeded ``seed`` (the same wherever it runs)."""
     return np.random.default_rng([seed, k])
@@ -144,8 +148,10 @@ class EpisodeSession(ABC, Generic[RecordT]):
         return episode_rng(self.seed, k)
 
     def log_for(self, k: int) -> Callable[[str], None]:
+        """Episode ``k``'s log: the run's for episode 0, else :func:`silent` (an episode can tell
+        that nothing reads its lines and skip formatting them)."""
         log = self.options.log if k == 0 else None
-        return log or (lambda _msg: None)
+        return log or silent
 
     def spawn(self, body: Body, static: bool = False) -> int:
         """Add a body for this episode only (removed before the next episode's restore)."""

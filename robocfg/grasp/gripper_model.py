@@ -93,12 +93,20 @@ class GripperBoxes:
 
     def closing_sweep(self, width: float | None = None) -> GripperBoxes:
         """Each link's box grown to cover it from open until the fingers reach ``width`` (m;
-        None: fully closed) — for support-plane checks of the closing motion."""
-        lo, hi = self.lo.copy(), self.hi.copy()
-        for s in self.samples:
-            if width is None or s.gap >= width - CLOSING_TOLERANCE:
-                lo, hi = np.minimum(lo, s.lo), np.maximum(hi, s.hi)
-        return GripperBoxes(lo, hi, self.names, self.finger, self.max_width)
+        None: fully closed) — for support-plane checks of the closing motion. Made once per set of
+        openings it covers (the same samples give the same boxes; read-only: every episode's
+        grasp search asks for it)."""
+        used = tuple(i for i, s in enumerate(self.samples) if width is None or s.gap >= width - CLOSING_TOLERANCE)
+        kept: dict[tuple[int, ...], GripperBoxes] = self.__dict__.setdefault("_sweeps", {})
+        out = kept.get(used)
+        if out is None:
+            lo, hi = self.lo.copy(), self.hi.copy()
+            for i in used:
+                lo, hi = np.minimum(lo, self.samples[i].lo), np.maximum(hi, self.samples[i].hi)
+            lo.setflags(write=False)
+            hi.setflags(write=False)
+            out = kept[used] = GripperBoxes(lo, hi, self.names, self.finger, self.max_width)
+        return out
 
     def swept(self, standoff: float) -> GripperBoxes:
         """Boxes covering the straight motion from ``standoff`` m back along the approach."""

@@ -105,10 +105,17 @@ def iter_top_down_groups(obj: LyingObject, boxes: GripperBoxes) -> Iterator[list
     angles = [yaw, yaw + math.pi / 2, *(yaw + k * math.pi / DIRECTIONS for k in range(1, DIRECTIONS) if k != DIRECTIONS // 2)]
     w_max = usable_width(boxes)
     options = []
+    # a direction's extremes as Python floats (numpy's values: max and min of finite numbers are
+    # exact); with a non-finite point, numpy's reductions as before (NaN propagates there)
+    finite = bool(np.isfinite(rel).all())
     for order, a in enumerate(angles):
         d = np.array([math.cos(a), math.sin(a)])
-        proj = rel @ d
-        hi, lo = proj.max(), proj.min()
+        if finite:
+            values = (rel @ d).tolist()
+            hi, lo = max(values), min(values)
+        else:
+            proj = rel @ d
+            hi, lo = proj.max(), proj.min()
         width = float(hi - lo)
         if width > w_max:
             continue

@@ -21,6 +21,7 @@ import numpy as np
 from robocfg.assets.object_shape import object_shape
 from robocfg.checks.grip_force import grip_budget
 from robocfg.config.commands import PickPlaceParams
+from robocfg.engine.session import silent
 from robocfg.geometry import quat_to_matrix
 from robocfg.grasp.object_grasp import LyingObject
 from robocfg.kinematics.frames import Grasp
@@ -48,7 +49,8 @@ class _StateMachine(GraspChoice):
     def __init__(self, world, arm, tools: _Tools, params: PickPlaceParams, setup: EpisodeSetup, recorder,
                  log: Log | None, body_id: int | None = None):
         self.world, self.params, self.setup, self.recorder = world, params, setup, recorder
-        self.log = log or (lambda _msg: None)
+        self.log = log or silent
+        self.logs = self.log is not silent  # False: no line is read, none is formatted
         self.arm, self.cfg, self.gripper = arm, arm.config, arm.require_gripper()
         self.model = tools.model
         self.reactive = tools.reactive
@@ -138,8 +140,8 @@ class _StateMachine(GraspChoice):
         self.mover.phase, self.mover.timeout = name, getattr(self.params.timeouts, name, None)
         if self.recorder is not None:
             self.recorder.set_phase(name)
-        n = len(self.phases) + 1
-        self.log(f"Phase {n}: {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
+        if self.logs:
+            self.log(f"Phase {len(self.phases) + 1}: {name.replace('_', '-')} — {what} (t = {self.world.t:.2f} s)")
 
     def close_phase(self, ok: bool, detail: str = "") -> None:
         if self._phase is None:
@@ -197,8 +199,9 @@ class _StateMachine(GraspChoice):
             budget = replace(budget, pad_force=budget.pad_force * self.params.grip_force / budget.limit)
         a = budget.max_acceleration()
         self.mover.max_acceleration = a
-        self.log(f"  grip: {budget.pad_force:.1f} N per pad at {width * 1000:.0f} mm; the held object may "
-                 f"be accelerated up to {a:.1f} m/s²")
+        if self.logs:
+            self.log(f"  grip: {budget.pad_force:.1f} N per pad at {width * 1000:.0f} mm; the held object may "
+                     f"be accelerated up to {a:.1f} m/s²")
 
     def _release(self) -> None:
         """Open until the object is free and the fingers are 90 % open. Opening rebuilds the

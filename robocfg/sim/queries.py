@@ -35,6 +35,36 @@ class PairPoint:
     distance: float
 
 
+def _segment(start: Sequence[float], end: Sequence[float]) -> tuple[list[float], list[float], float, list[float]]:
+    """(start, end, length m, unit direction) of a segment as Python floats, with the bits of
+    ``a, b = np.asarray(start, float), np.asarray(end, float)``, ``float(np.linalg.norm(b - a))``
+    and ``((b - a) / length).tolist()``. Where at most one coordinate changes along the segment
+    (the support queries' vertical rays) the length is that coordinate's |difference| without a
+    numpy call: numpy's norm is the square root of a dot product whose other terms are zero, and
+    in binary floating point the square root of a correctly rounded square gives back the
+    magnitude exactly (within the range checked here: no overflow or underflow of the square)."""
+    if len(start) != 3 or len(end) != 3:
+        raise ValueError(f"a segment needs two 3-D points, got {len(start)} and {len(end)} coordinates")
+    x0, y0, z0 = start
+    x1, y1, z1 = end
+    a = [float(x0), float(y0), float(z0)]
+    b = [float(x1), float(y1), float(z1)]
+    dx, dy, dz = diff = [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+    if dx == 0.0 and dy == 0.0:
+        length = abs(dz)
+    elif dx == 0.0 and dz == 0.0:
+        length = abs(dy)
+    elif dy == 0.0 and dz == 0.0:
+        length = abs(dx)
+    else:
+        length = -1.0
+    if not (length == 0.0 or 1e-150 < length < 1e150):  # two or more coordinates change, or out of range
+        length = float(np.linalg.norm(np.array(diff)))
+    if length == 0.0:
+        return a, b, 0.0, diff
+    return a, b, length, [dx / length, dy / length, dz / length]
+
+
 class SceneQueries:
     """Physics queries of a world (needs ``client`` and ``body_id``)."""
 
@@ -64,7 +94,13 @@ class SceneQueries:
         body's bounding box (:meth:`_past_skipped`), instead of casting through them (a robot arm
         above the point: 3–4 casts a link). The same surface is found, but its hit point may
         differ from a walk from ``start`` in the last bits (a cast's fraction depends on where it
-        starts): for answers that only go to a tolerance check."""
+        starts): for answers that only go to a tolerance check. The bodies ahead are found in
+        PyBullet's broadphase (``getOverlappingObjects``), whose boxes are brought up to date by a
+        physics step (``stepSimulation``, or ``performCollisionDetection``) and not by a teleport: a
+        caller that has moved a body (``resetBasePositionAndOrientation``, a joint reset, a
+        restore) and casts before the world has stepped must not pass ``jump_skipped`` (a body
+        moved into the ray since the last step is not listed, and the jump could start past its
+        surface)."""
         if jump_skipped and skip:
             start = self._past_skipped(start, end, skip)
         for hit in self._ray_walk(start, end, max_hits):
@@ -81,15 +117,14 @@ class SceneQueries:
         millimetre of a convex shape reports a hit *at its start*: 0.1 mm short of a table's box
         gave a height 0.1 mm too high; a skipped body's such hit is walked through.) ``start``
         itself when no skipped box lies wholly before that point (nothing to jump: the walk is then
-        the same, bit for bit)."""
-        a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
-        length = float(np.linalg.norm(b - a))
+        the same, bit for bit). The broadphase it asks is only current after a physics step (see
+        :meth:`first_ray_hit`)."""
+        a0, b0, length, d = _segment(start, end)
         if length == 0.0:
             return start
-        d = ((b - a) / length).tolist()  # Python floats from here (numpy's per-element cost aside)
-        a0 = a.tolist()
         c = self.client
-        pairs = p.getOverlappingObjects(np.minimum(a, b).tolist(), np.maximum(a, b).tolist(), physicsClientId=c)
+        pairs = p.getOverlappingObjects([min(u, v) for u, v in zip(a0, b0, strict=True)],
+                                        [max(u, v) for u, v in zip(a0, b0, strict=True)], physicsClientId=c)
         skipped: list[tuple[float, float]] = []  # (entry, exit) along the ray (m from start)
         first_other = length
         moving = [(k, a0[k], d[k]) for k in range(3) if abs(d[k]) >= 1e-12]
@@ -126,15 +161,13 @@ class SceneQueries:
 
     def _ray_walk(self, start: Sequence[float], end: Sequence[float], max_hits: int) -> Iterator[RayHit]:
         """:meth:`ray_hits`'s hits, nearest first, each cast made when the previous hit has been taken."""
-        a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
-        length = float(np.linalg.norm(b - a))
+        a, to, length, d = _segment(start, end)
         if length == 0.0:
             return
         # Python floats from here (the same IEEE operations as the arrays' element by element,
         # without numpy's per-call cost on 3-vectors): the direction, and the ray's start per cast
-        dx, dy, dz = d = ((b - a) / length).tolist()
-        ax, ay, az = a.tolist()
-        to = b.tolist()
+        dx, dy, dz = d
+        ax, ay, az = a
         axes = [k for k in range(3) if abs(d[k]) > 1e-12]
         ray, aabb, c = p.rayTest, p.getAABB, self.client
         found = 0
