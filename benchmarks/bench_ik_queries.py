@@ -9,7 +9,7 @@ wrapped: each outermost call is recorded (target, seed, frame, budget, the solve
 with its answer, its iterations and its CPU (``time.thread_time``) in the episode, and a call site
 read from the stack: ``line end`` / ``line cut`` (a straight line's IK at fraction 1 / below 1,
 ``robocfg.motion.straight_line``), else the first function outside the kinematics and the mover's
-IK helpers (``reach``: the grasp choice's reach checks; ``_free_move``: a joint-space move...).
+IK helpers (``_leg``: the grasp choice's reach checks; ``_free_move``: a joint-space move...).
 The queries are then replayed ``--rounds`` times on the same model, warm (hot caches: a lower bound
 of the in-episode cost), and each replayed answer must equal the recorded one bit for bit (the
 solver is deterministic with an iteration cap). ``--base DIR`` (``git archive <commit> robocfg | tar

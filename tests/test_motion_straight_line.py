@@ -180,6 +180,31 @@ def test_straight_end_is_the_lines_last_waypoint_with_fewer_solves(kin, delta, t
     assert len(calls) <= line_calls
 
 
+@pytest.mark.parametrize("turn", [0.0, 0.03])
+def test_straight_end_after_the_direct_answer_asks_nothing_new(kin, turn, monkeypatch):
+    """A joint-space move asks the goal from q0 (``ArmMover.solve``), then where a line would end:
+    without a turn at the start, the line's one solve is that same question, answered from the
+    mover's remembered answers (the same bits, no solve); with a turn, the point 3 cm along and the
+    end from it are new questions."""
+    from robocfg.geometry.rotation import axis_angle_matrix
+
+    R = axis_angle_matrix([0.0, 0.0, 1.0], turn) @ DOWN
+    q_start = kin.ik(np.block([[R, np.array([[0.45], [0.05], [0.35]])], [np.zeros((1, 3)), 1.0]]),
+                     seed_q=kin.home, frame="ee").q
+    T_goal = np.block([[DOWN, (kin.fk(q_start, "ee")[:3, 3] + (0.25, -0.1, 0.05))[:, None]], [np.zeros((1, 3)), 1.0]])
+    mover, calls, counted = _counting_mover(kin)
+    monkeypatch.setattr(kin, "ik", counted)
+    q_direct = mover.solve(T_goal, q_start)
+    assert len(calls) == 1
+    calls.clear()
+    q_end = mover.straight_end(q_start, T_goal)
+    assert len(calls) == (2 if turn else 0)
+    if not turn:
+        assert q_end.tobytes() == q_direct.tobytes()
+    fresh, _, _ = _counting_mover(kin)  # nothing remembered: the same answer from the solver
+    assert fresh.straight_end(q_start, T_goal).tobytes() == q_end.tobytes()
+
+
 def test_straight_end_fails_where_the_lines_first_points_fail():
     """Unreachable ends are named as the line names them; where the checked line breaks further
     on (the branch case), the end is still an answer of the goal (a joint-space goal needs no

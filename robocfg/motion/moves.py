@@ -130,18 +130,21 @@ class ArmMover:
 
     def straight_end(self, q0: np.ndarray, T_goal: np.ndarray) -> np.ndarray:
         """Where a straight line from FK(q0) to ``T_goal`` would end, without building and checking
-        the line (:func:`~robocfg.motion.straight_line.straight_line_end`): a joint-space goal on q0's branch."""
+        the line (:func:`~robocfg.motion.straight_line.straight_line_end`): a joint-space goal on q0's branch.
+        Its IK goes through :meth:`ik`'s remembered answers: where the orientation need not turn
+        first, its one solve is the goal from q0, the question :meth:`move` has just asked."""
         from robocfg.motion.straight_line import straight_line_end
 
-        return straight_line_end(self.model, q0, T_goal, *self._line_calls())
+        return straight_line_end(self.model, q0, T_goal, *self._line_calls(self.ik))
 
-    def _line_calls(self) -> tuple[Solve, Fail, Unreachable]:
-        """(IK, failure, unreachable) for the straight-line functions. IK goes straight to the
-        solver, not through the answers remembered by self.ik: the points of a line are asked
-        from the line's own seeds, never twice in an episode."""
-        ik, budget = self.model.ik, self.ik_budget
-        return (lambda T, seed: ik(T, seed_q=seed, frame="ee", time_budget=budget),
-                lambda reason: MoveFailed(self.phase, reason), self._unreachable)
+    def _line_calls(self, ik: Solve | None = None) -> tuple[Solve, Fail, Unreachable]:
+        """(IK, failure, unreachable) for the straight-line functions. IK (``ik`` None) goes
+        straight to the solver, not through the answers remembered by self.ik: the points of a
+        line are asked from the line's own seeds, never twice in an episode."""
+        if ik is None:
+            solve, budget = self.model.ik, self.ik_budget
+            ik = lambda T, seed: solve(T, seed_q=seed, frame="ee", time_budget=budget)  # noqa: E731
+        return ik, lambda reason: MoveFailed(self.phase, reason), self._unreachable
 
     def move(self, T_goal: np.ndarray, straight: bool, q_goal: np.ndarray | None = None,
              check: Callable[[], str | None] | None = None) -> None:

@@ -57,21 +57,6 @@ class GraspChoice:
         one of two half-turn twins, e.g. a Panda's shoulder flipped by ≈ 3 rad, or a wrist that
         must wind round a joint limit to carry.)"""
         first: list[Grasp] | None = None
-
-        def reach(g: Grasp) -> tuple[float, list[tuple[np.ndarray, np.ndarray]]]:
-            """(joint travel in rad, the straight lines down to check: (start q, goal EE pose));
-            inf travel: unreachable."""
-            shift = np.array([*(self.setup.place_xy - g.center[:2]), 0.0])
-            T_pre, T_grasp = self._grasp_poses(g)
-            cost, q, lines = 0.0, q0, []
-            for T, T_down in ((T_pre, T_grasp), (shifted(T_pre, shift), shifted(T_grasp, shift))):
-                res = self.mover.ik(T, q)
-                if not res.converged:
-                    return math.inf, []
-                cost, q = max(cost, float(np.max(np.abs(res.q - q)))), res.q
-                lines.append((q, T_down))
-            return cost, lines
-
         R_ee_graspnet = np.asarray(self.cfg.R_ee_graspnet)
         for group in self._iter_grasp_groups(lying):  # searched one at a time: usually the first will do
             if first is None:
@@ -79,17 +64,17 @@ class GraspChoice:
                 R_now = self.arm.ee_pose()[:3, :3]
                 q0 = self.arm.joint_positions()
             cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ R_ee_graspnet))
-            reached = [reach(g) for g in cands]
-            order = sorted((i for i, (cost, _) in enumerate(reached) if cost < math.inf), key=lambda i: (reached[i][0], i))
-            if not order:
-                continue
+            reach = _Reach(self, cands, q0)
+            cheapest: int | None = None
             # The least travel among those whose lines are continuous (ties: the smaller wrist turn),
             # else the least travel: the lines (the costly part, IK every 3 cm) are checked in order
             # of travel, only until one candidate passes.
-            for i in order:
-                if all(self._line_continuous(q, T_down) for q, T_down in reached[i][1]):
+            for i in reach.order():
+                cheapest = i if cheapest is None else cheapest
+                if all(self._line_continuous(q, T_down) for q, T_down in reach.lines[i]):
                     return cands[i]
-            return cands[order[0]]
+            if cheapest is not None:
+                return cands[cheapest]
         if first is None:
             raise MoveFailed("grasp_choice", self._no_grasp_reason(lying))
         return first[0]
@@ -154,6 +139,52 @@ class GraspChoice:
         return (f"no grasp height: closing to {narrow * 1000:.1f} mm the fingertips reach {tip * 1000:.0f} mm past the "
                 f"TCP, so with them above the support and the palm above the object's top the pads cannot reach the "
                 f"object ({(lying.top_z - lying.bottom_z) * 1000:.0f} mm tall)")
+
+
+class _Reach:
+    """The joint travel of a group's candidates (rad): for each, the largest |Δq| of its two legs,
+    IK from the current joints ``q0`` to the pre-grasp pose, then from there to the same pose above
+    the place point (each leg's answer is a straight line's start, down to the grasp or the place
+    height). The first leg of every candidate is solved at once; a second leg only when its
+    candidate could still come next in the order of travel (the first leg bounds the travel from
+    below), so candidates that cannot win cost one IK solve instead of two. The same order as
+    sorting every candidate's full travel, ties to the earlier candidate (the smaller wrist turn)."""
+
+    def __init__(self, choice: GraspChoice, cands: list[Grasp], q0: np.ndarray):
+        self.ik = choice.mover.ik
+        self.legs: list[list[tuple[np.ndarray, np.ndarray]]] = []  # per candidate: (EE pose to reach, its line's goal)
+        for g in cands:
+            shift = np.array([*(choice.setup.place_xy - g.center[:2]), 0.0])
+            T_pre, T_grasp = choice._grasp_poses(g)
+            self.legs.append([(T_pre, T_grasp), (shifted(T_pre, shift), shifted(T_grasp, shift))])
+        self.cost = [0.0] * len(cands)  # travel so far (a lower bound until both legs are solved); inf: unreachable
+        self.q = [q0] * len(cands)  # the last leg's answer
+        self.lines: list[list[tuple[np.ndarray, np.ndarray]]] = [[] for _ in cands]  # (start q, goal EE pose)
+        for i in range(len(cands)):
+            self._leg(i)
+
+    def _leg(self, i: int) -> None:
+        """Solve candidate ``i``'s next leg."""
+        T, T_down = self.legs[i][len(self.lines[i])]
+        res = self.ik(T, self.q[i])
+        if not res.converged:
+            self.cost[i] = math.inf
+            return
+        self.cost[i], self.q[i] = max(self.cost[i], float(np.max(np.abs(res.q - self.q[i])))), res.q
+        self.lines[i].append((res.q, T_down))
+
+    def order(self) -> Iterator[int]:
+        """The reachable candidates' indices by (travel, index), both legs solved for each one given."""
+        pending = [i for i, c in enumerate(self.cost) if c < math.inf]
+        while pending:
+            i = min(pending, key=lambda i: (self.cost[i], i))  # the others' keys can only grow
+            if len(self.lines[i]) < len(self.legs[i]):
+                self._leg(i)
+                if self.cost[i] == math.inf:
+                    pending.remove(i)
+                continue
+            pending.remove(i)
+            yield i
 
 
 def half_turn(g: Grasp) -> Grasp:
