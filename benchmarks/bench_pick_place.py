@@ -50,7 +50,7 @@ def main() -> None:
     quiet_import()
     from robocfg.checks import load_task
     from robocfg.config import catalog
-    from robocfg.runners.pick_place import run_pick_place
+    from robocfg.engine import RunOptions, run
 
     base = load_task(catalog.find("tasks", args.task), robot_override=args.robot)
     rz = base.config.pick_place.randomize
@@ -59,7 +59,8 @@ def main() -> None:
     varied = type(base)(base.config.model_copy(update={"pick_place": varied_params}), base.doc, base.robots)
     rows = []
     for label, task in (("as shipped", base), ("±10 % mass & friction", varied)):
-        report, timing = run_pick_place(task, episodes=args.episodes, seed=args.seed)
+        out = run(task, RunOptions(seed=args.seed, episodes=args.episodes, time_physics=True))  # physics timed
+        report, timing = out.report, out.timing
         steps = float(np.mean([e.steps for e in report.episodes]))
         bare = bare_loop_seconds(task, round(steps))
         per_ep = timing.mean_episode

@@ -257,7 +257,7 @@ def distributed(task, kind: str, workers: int, episodes: int, rnd: int, dataset:
     from robocfg.executors.session import plan_batches
 
     target = _target(dataset, task)
-    recipe = EngineRecipe.of(task, RunOptions(seed=0, episodes=episodes), target)
+    recipe = EngineRecipe.of(task, RunOptions(seed=0, episodes=episodes, time_physics=True), target)  # physics timed
     pool = RayPool(workers, keep=kind == "ray-kept") if kind in RAY_KINDS else ProcessPool(workers, setup_of(kind))
     asked = time.time()
     t0 = time.perf_counter()

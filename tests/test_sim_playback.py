@@ -168,3 +168,38 @@ def test_idle_world_skips_only_no_op_gripper_updates(tmp_path):
         assert not g.busy() and w.idle()
         w.step_hooks.append(lambda: None)
         assert not w.idle()
+
+
+def _played_every_way(tmp_path, timed: bool) -> tuple[list, list[float]]:
+    """A bare play, idle steps, a hooked play and single steps (every loop that steps the world),
+    with the world's physics clock on or off: the joint states and ``physics_seconds`` after each."""
+    with World(make_task(tmp_path, PANDA), time_physics=timed) as w:
+        arm = w.robot.arm()
+        q, qd = _rows(arm, 60)
+        states, seconds = [], []
+
+        def done() -> None:
+            states.append((_state(w), w.steps, w.t))
+            seconds.append(w.physics_seconds)
+
+        w.play(arm, q, qd)  # bare
+        done()
+        w.step(30)  # idle
+        done()
+        w.play(arm, q[::-1], -qd[::-1], after=lambda: None)  # hooked
+        done()
+        arm.gripper.rate = 2.0
+        arm.gripper.close()
+        w.step(20)  # per step (a busy gripper)
+        done()
+        return states, seconds
+
+
+def test_physics_clock_is_opt_in_and_changes_nothing(tmp_path):
+    """``World(time_physics=True)`` times every physics step (``physics_seconds``, for benchmarks);
+    off (the default) nothing is timed, and the simulation is the same bit for bit either way."""
+    untimed, seconds_off = _played_every_way(tmp_path, False)
+    timed, seconds_on = _played_every_way(tmp_path, True)
+    assert untimed == timed
+    assert seconds_off == [0.0] * 4
+    assert all(b > a for a, b in zip([0.0, *seconds_on], seconds_on, strict=False))  # each loop timed its steps

@@ -86,6 +86,8 @@ class RunOptions:
     log: Callable[[str], None] | None = None  # phase log of episode 0 (one line per phase)
     sink: EpisodeSink | None = None  # a dataset sink (``robocfg.datasets.sink.DatasetSink``) recording every episode
     resumed: tuple[Any, ...] = ()  # records of episodes an interrupted run finished: not run again, reported
+    # time every physics step (World.time_physics): BatchTiming.physics_per_episode, for benchmarks; off, it reads 0
+    time_physics: bool = False
 
     def resolved_seed(self, task_seed: int) -> int:
         return task_seed if self.seed is None else self.seed

@@ -43,7 +43,8 @@ class BatchTiming:
 
     wall_time: float = 0.0
     per_episode: list[float] = field(default_factory=list)
-    physics_per_episode: list[float] = field(default_factory=list)  # s inside the physics engine's step
+    # s inside the physics engine's step; measured only with RunOptions.time_physics (0 otherwise)
+    physics_per_episode: list[float] = field(default_factory=list)
 
     @property
     def mean_physics(self) -> float:
@@ -97,7 +98,8 @@ class EpisodeSession(ABC, Generic[RecordT]):
     def _build_world(self) -> None:
         from robocfg.sim.world import World
 
-        self.world: World = World(self.task, gui=self.options.gui, visuals=self.draws())
+        self.world: World = World(self.task, gui=self.options.gui, visuals=self.draws(),
+                                  time_physics=self.options.time_physics)
         try:
             self.world.step(1)
             self.prepare()

@@ -70,12 +70,13 @@ def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q: np.ndarray, qd:
     """The bare loop (module docstring): one motor call and one physics step per row. The rows
     become Python lists one check period at a time (what PyBullet reads fastest), so a move's
     targets never exist as one big list of floats: the chunk's floats are freed before the next
-    chunk's are made (and come back from Python's free list, in cache)."""
+    chunk's are made (and come back from Python's free list, in cache). The physics steps are
+    timed only while ``world.time_physics``."""
     _, idx, kp, kd, force, drives = plan
     robot = arm.robot
     body, client, mode = robot.body_id, robot.client, p.POSITION_CONTROL
     send, stepsim, clock = p.setJointMotorControlArray, p.stepSimulation, time.perf_counter
-    every, steps, n = world.check_every, world.steps, len(q)
+    every, steps, n, timed = world.check_every, world.steps, len(q), world.time_physics
     physics, i, j = 0.0, 0, -1
     rows: list = []
     speeds: list = []
@@ -85,13 +86,19 @@ def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q: np.ndarray, qd:
             rows, speeds = q[i:end].tolist(), qd[i:end].tolist()
             j = -1
             try:
-                for j, row in enumerate(rows):  # j is read when a step raises
-                    # positional: setJointMotorControlArray(body, joints, mode, targetPositions,
-                    # targetVelocities, forces, positionGains, velocityGains, physicsClientId)
-                    send(body, idx, mode, row, speeds[j], force, kp, kd, client)
-                    t0 = clock()
-                    stepsim(client)
-                    physics += clock() - t0
+                # positional: setJointMotorControlArray(body, joints, mode, targetPositions,
+                # targetVelocities, forces, positionGains, velocityGains, physicsClientId);
+                # j is read when a step raises
+                if timed:
+                    for j, row in enumerate(rows):
+                        send(body, idx, mode, row, speeds[j], force, kp, kd, client)
+                        t0 = clock()
+                        stepsim(client)
+                        physics += clock() - t0
+                else:
+                    for j, row in enumerate(rows):
+                        send(body, idx, mode, row, speeds[j], force, kp, kd, client)
+                        stepsim(client)
             except BaseException:  # stopped inside the chunk: its steps before j were taken
                 world.steps = steps + max(j, 0)
                 world.t = world.steps * world.dt
@@ -120,7 +127,7 @@ def _play_hooked(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd
     # World._advance, inlined (keep the two in step): physics step, clock, grippers, the periodic
     # divergence check and stop request, step hooks.
     stepsim, clock, dt, every = p.stepSimulation, time.perf_counter, world.dt, world.check_every
-    grippers, hooks = world.grippers, world.step_hooks
+    grippers, hooks, timed = world.grippers, world.step_hooks, world.time_physics
     sent: tuple[list[float], list[float]] | None = None
     physics = 0.0
     try:
@@ -135,9 +142,12 @@ def _play_hooked(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd
             if current is not None:
                 send(body, idx, mode, row, speeds, force, kp, kd, client)
                 sent = (row, speeds)
-            t0 = clock()
-            stepsim(client)
-            physics += clock() - t0
+            if timed:
+                t0 = clock()
+                stepsim(client)
+                physics += clock() - t0
+            else:
+                stepsim(client)
             world.steps = steps = world.steps + 1
             world.t = steps * dt
             for g in grippers:
@@ -156,18 +166,23 @@ def _play_hooked(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd
 
 def advance_idle(world: World, n: int) -> None:
     """``n`` physics steps while nothing but physics runs (``world.idle()``): the clock and the
-    periodic divergence check and stop request at the same steps as ``n`` calls of ``World.step``."""
+    periodic divergence check and stop request at the same steps as ``n`` calls of ``World.step``
+    (the steps timed only while ``world.time_physics``)."""
     client, stepsim, clock = world.client, p.stepSimulation, time.perf_counter
-    every, steps = world.check_every, world.steps
+    every, steps, timed = world.check_every, world.steps, world.time_physics
     physics, done, k = 0.0, 0, 0
     try:
         while done < n:
             m = min(n - done, every - steps % every)
             try:
-                for k in range(m):  # noqa: B007 - k is read when a step raises
-                    t0 = clock()
-                    stepsim(client)
-                    physics += clock() - t0
+                if timed:
+                    for k in range(m):  # noqa: B007 - k is read when a step raises
+                        t0 = clock()
+                        stepsim(client)
+                        physics += clock() - t0
+                else:
+                    for k in range(m):  # noqa: B007 - k is read when a step raises
+                        stepsim(client)
             except BaseException:  # stopped inside the chunk: its steps before k were taken
                 world.steps = steps + k
                 world.t = world.steps * world.dt
@@ -209,15 +224,18 @@ def play_latched(world: World, arm: ArmHandle, q_rows: list, gate: Latched, step
     body, client, mode = robot.body_id, robot.client, p.POSITION_CONTROL
     send, tokens = p.setJointMotorControlArray, robot.drive_token
     stepsim, clock, dt, every, n = p.stepSimulation, time.perf_counter, world.dt, world.check_every, steps_per_frame
-    grippers = world.grippers
+    grippers, timed = world.grippers, world.time_physics
     sent: tuple[list[float], list[float]] | None = None
     physics = 0.0
     try:
         for row in q_rows:
             gate.q_wanted = row
-            t0 = clock()
-            stepsim(client)
-            physics += clock() - t0
+            if timed:
+                t0 = clock()
+                stepsim(client)
+                physics += clock() - t0
+            else:
+                stepsim(client)
             world.steps = steps = world.steps + 1
             world.t = steps * dt
             for g in grippers:
