@@ -203,3 +203,39 @@ def test_physics_clock_is_opt_in_and_changes_nothing(tmp_path):
     assert untimed == timed
     assert seconds_off == [0.0] * 4
     assert all(b > a for a, b in zip([0.0, *seconds_on], seconds_on, strict=False))  # each loop timed its steps
+
+
+def _interrupted(tmp_path, monkeypatch, how: str, at: int):
+    """Play the rows with ``stepSimulation`` raising KeyboardInterrupt on its ``at``-th call of the
+    play (inside a check period): the world's clock and the drives' targets where it stopped."""
+    with World(make_task(tmp_path, PANDA)) as w:
+        arm = w.robot.arm()
+        q, qd = _rows(arm)
+        w.step(5)  # off the check grid
+        calls = [0]
+        step = p.stepSimulation
+
+        def flaky(*a, **k):
+            calls[0] += 1
+            if calls[0] == at:
+                raise KeyboardInterrupt
+            return step(*a, **k)
+
+        monkeypatch.setattr(p, "stepSimulation", flaky)
+        with pytest.raises(KeyboardInterrupt):
+            if how == "fast":
+                w.play(arm, q, qd)
+            else:
+                for row, v in zip(q.tolist(), qd.tolist(), strict=True):
+                    arm.command(row, v)
+                    w.step()
+        monkeypatch.setattr(p, "stepSimulation", step)
+        drives = w.robot.drives
+        return _state(w), w.steps, w.t, [(drives[j].target, drives[j].target_velocity) for j in arm.joints]
+
+
+@pytest.mark.parametrize("at", [1, 7, 8, 50])
+def test_bare_loop_stopped_inside_a_check_period_as_the_per_step_loop(tmp_path, monkeypatch, at):
+    fast = _interrupted(tmp_path, monkeypatch, "fast", at)
+    assert fast == _interrupted(tmp_path, monkeypatch, "slow", at)
+    assert fast[1] == 5 + at - 1  # the steps before the one that raised

@@ -29,8 +29,9 @@ hook or busy gripper needs the steps one by one). The drives' recorded targets
 
 from __future__ import annotations
 
+import struct
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
@@ -51,7 +52,7 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
     intercepted = "command" in vars(arm)
     plan = None if intercepted else robot.motor_plan(key)
     if plan is not None and after is None and world.idle():
-        _play_bare(world, arm, plan, q, qd)  # converts its rows chunk by chunk
+        _play_bare(world, arm, plan, np.ascontiguousarray(q), np.ascontiguousarray(qd))  # read as bytes
         return
     q_rows, qd_rows = q.tolist(), qd.tolist()  # once, not per step
     if intercepted and world.play_through is not None and world.play_through(arm, q_rows, qd_rows, after):
@@ -67,53 +68,54 @@ def play_rows(world: World, arm: ArmHandle, q: np.ndarray, qd: np.ndarray,
 
 
 def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q: np.ndarray, qd: np.ndarray) -> None:
-    """The bare loop (module docstring): one motor call and one physics step per row. The rows
-    become Python lists one check period at a time (what PyBullet reads fastest), so a move's
-    targets never exist as one big list of floats: the chunk's floats are freed before the next
-    chunk's are made (and come back from Python's free list, in cache). The physics steps are
-    timed only while ``world.time_physics``."""
+    """The bare loop (module docstring): one motor call and one physics step per row. Each step's
+    targets and velocities reach PyBullet as two tuples of Python floats read straight from the
+    arrays' bytes (``struct.iter_unpack``, native doubles: the same floats as ``tolist``), made as
+    the step comes and freed after it, so they come back from Python's float free list, in cache;
+    no list of a move's floats is ever built. The divergence check and the stop request come every
+    ``world.check_every`` steps (a countdown), as in :meth:`World.step`. The physics steps are timed
+    only while ``world.time_physics``."""
     _, idx, kp, kd, force, drives = plan
     robot = arm.robot
     body, client, mode = robot.body_id, robot.client, p.POSITION_CONTROL
     send, stepsim, clock = p.setJointMotorControlArray, p.stepSimulation, time.perf_counter
-    every, steps, n, timed = world.check_every, world.steps, len(q), world.time_physics
-    physics, i, j = 0.0, 0, -1
-    rows: list = []
-    speeds: list = []
+    every, dt, timed = world.check_every, world.dt, world.time_physics
+    unpack = struct.Struct(f"{q.shape[1]}d").iter_unpack  # native doubles: numpy's float64 layout
+    base = world.steps  # the world's steps at the last check (or at the start)
+    left = mark = every - base % every  # steps to the next check, and that distance from base
+    physics = 0.0
+    row = speeds = None
     try:
-        while i < n:
-            end = min(n, i + every - steps % every)  # the next check is after this chunk's last step
-            rows, speeds = q[i:end].tolist(), qd[i:end].tolist()
-            j = -1
-            try:
-                # positional: setJointMotorControlArray(body, joints, mode, targetPositions,
-                # targetVelocities, forces, positionGains, velocityGains, physicsClientId);
-                # j is read when a step raises
-                if timed:
-                    for j, row in enumerate(rows):
-                        send(body, idx, mode, row, speeds[j], force, kp, kd, client)
-                        t0 = clock()
-                        stepsim(client)
-                        physics += clock() - t0
-                else:
-                    for j, row in enumerate(rows):
-                        send(body, idx, mode, row, speeds[j], force, kp, kd, client)
-                        stepsim(client)
-            except BaseException:  # stopped inside the chunk: its steps before j were taken
-                world.steps = steps + max(j, 0)
-                world.t = world.steps * world.dt
-                raise
-            steps += end - i
-            i = end
-            world.steps, world.t = steps, steps * world.dt
-            if steps % every == 0:
-                world.periodic_check()
-    finally:
+        # positional: setJointMotorControlArray(body, joints, mode, targetPositions,
+        # targetVelocities, forces, positionGains, velocityGains, physicsClientId)
+        if timed:
+            for row, speeds in zip(unpack(q.data), unpack(qd.data)):  # noqa: B905 - shapes checked by play_rows
+                send(body, idx, mode, row, speeds, force, kp, kd, client)
+                t0 = clock()
+                stepsim(client)
+                physics += clock() - t0
+                left -= 1
+                if not left:
+                    base += mark
+                    left = mark = every
+                    world.steps, world.t = base, base * dt
+                    world.periodic_check()
+        else:
+            for row, speeds in zip(unpack(q.data), unpack(qd.data)):  # noqa: B905 - shapes checked by play_rows
+                send(body, idx, mode, row, speeds, force, kp, kd, client)
+                stepsim(client)
+                left -= 1
+                if not left:
+                    base += mark
+                    left = mark = every
+                    world.steps, world.t = base, base * dt
+                    world.periodic_check()
+    finally:  # the steps taken (a step that raised is not), also when stopped or diverged
+        steps = base + mark - left
+        world.steps, world.t = steps, steps * dt
         world.physics_seconds += physics
-        if j >= 0:  # the drives remember the last targets sent, as command() leaves them
-            _remember(drives, rows[j], speeds[j])
-        elif i > 0:  # stopped between two chunks
-            _remember(drives, q[i - 1].tolist(), qd[i - 1].tolist())
+        if row is not None and speeds is not None:  # the drives remember the last targets sent, as command() leaves them
+            _remember(drives, row, speeds)
 
 
 def _play_hooked(world: World, arm: ArmHandle, plan: MotorPlan, q_rows: list, qd_rows: list,
@@ -265,6 +267,6 @@ def play_latched(world: World, arm: ArmHandle, q_rows: list, gate: Latched, step
     return True
 
 
-def _remember(drives: list[Drive], row: list[float], speeds: list[float]) -> None:
+def _remember(drives: list[Drive], row: Sequence[float], speeds: Sequence[float]) -> None:
     for d, v, w in zip(drives, row, speeds):  # noqa: B905 - one per arm joint
         d.target, d.target_velocity = v, w
