@@ -374,13 +374,14 @@ class World(SceneQueries):
         # unpacked in the loop's own assignment (no per-joint subscript); ≈ 15 % less CPU a
         # check than reading them through each robot's attributes (in situ, paired)
         c, vmax, states = self.client, self.max_joint_velocity, p.getJointStates
+        lo = -vmax
         read: list[tuple] = []
         self._checked = (self.steps, read)  # for a dataset frame at this step (checked_joint_states)
         for r, body, idx in self._joint_reads:
             joints = states(body, idx, c)
             read.append(joints)
             for _, v, _, _ in joints:
-                if not -vmax <= v <= vmax:  # also catches NaN
+                if not lo <= v <= vmax:  # also catches NaN
                     self._diverged_joint(r, [js[1] for js in joints])
         if self._dynamic:
             vbody2, base_velocity = self.max_body_speed ** 2, p.getBaseVelocity
