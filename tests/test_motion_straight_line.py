@@ -81,6 +81,48 @@ def test_waypoints_on_the_line_and_the_played_path_within_tolerance(kin, delta, 
     assert len(calls) < max(1, math.ceil(L / sl.CARTESIAN_STEP)) or len(calls) == 1  # fewer solves than every 3 cm
 
 
+@pytest.mark.parametrize("delta", [(0.0, 0.0, -0.12), (0.25, -0.1, 0.05), (-0.05, 0.3, -0.15)])
+@pytest.mark.parametrize("near", [True, False])
+def test_a_line_to_the_same_goal_reuses_the_checked_waypoints_that_still_hold(kin, delta, near, monkeypatch):
+    """The grasp choice checks the approach from the pre-grasp answer; the approach starts where the
+    pre-grasp move converged (a few 1e-5 rad away). The mover's second line to the same goal keeps
+    the first's waypoints behind the new start when they pass the same FK check (no IK solve), ends
+    at the same answer of the goal, and its played path is on the new line within tolerance; from
+    a start far enough away that they fail (1 cm aside), the line is cut or planned afresh, still
+    within tolerance."""
+    T_a = np.block([[DOWN, np.array([[0.45], [0.05], [0.35]])], [np.zeros((1, 3)), 1.0]])
+    q_a = kin.ik(T_a, seed_q=kin.home, frame="ee").q
+    T_goal = kin.fk(q_a, "ee")
+    T_goal[:3, 3] += delta
+    if near:  # every joint moved by up to 5e-5 rad
+        q_b = q_a + 5e-5 * np.cos(np.arange(kin.nq))
+    else:
+        T_b = T_a.copy()
+        T_b[:3, 3] += (0.006, 0.008, 0.0)
+        q_b = kin.ik(T_b, seed_q=q_a, frame="ee").q
+    mover, calls, counted = _counting_mover(kin)
+    monkeypatch.setattr(kin, "ik", counted)
+    W_a = mover.straight_waypoints(q_a, T_goal)
+    first_calls = len(calls)
+    calls.clear()
+    W_b, path = mover.straight_path(q_b, T_goal)
+    assert np.array_equal(W_b[0], q_b)
+    d, a = _line_error(kin, q_b, T_goal, path)
+    assert d <= 1.1 * sl.POSITION_TOLERANCE and a <= 1.1 * sl.ANGLE_TOLERANCE, (d, math.degrees(a))
+    assert np.allclose(kin.fk(W_b[-1], "ee"), T_goal, atol=1e-4)
+    monkeypatch.undo()
+    fresh, fresh_calls, counted = _counting_mover(kin)  # nothing remembered: planned from q_b alone
+    monkeypatch.setattr(kin, "ik", counted)
+    W_fresh = fresh.straight_waypoints(q_b, T_goal)
+    if near:  # where the pre-grasp move converges: the first line's waypoints, no solve
+        assert len(calls) == 0 < first_calls
+        assert W_b[1:].tobytes() == W_a[1:].tobytes()
+        assert np.abs(W_b - W_fresh).max() < 1e-3  # and close to a fresh plan's
+    else:  # they fail the check: a fresh plan, solve for solve
+        assert len(calls) == len(fresh_calls) > 0
+        assert W_b.tobytes() == W_fresh.tobytes()
+
+
 def test_a_line_that_crosses_a_branch_is_refused_and_an_unreachable_one_named():
     """The Panda's branch case (_sim_helpers.panda_branch_case): 13 cm straight down from this answer a
     joint would jump; and a line running out of the arm's reach names where."""

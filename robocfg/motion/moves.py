@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
     from robocfg.kinematics.model import KinematicModel
     from robocfg.motion.limits import JointLimits
-    from robocfg.motion.straight_line import Fail, Solve, Unreachable
+    from robocfg.motion.straight_line import Fail, Plan, Solve, Unreachable
     from robocfg.motion.trajectory import Trajectory
     from robocfg.sim.gripper.base import Gripper
     from robocfg.sim.robot import ArmHandle
@@ -90,6 +90,7 @@ class ArmMover:
     ik_budget: float = 1.0  # s of wall clock per IK query, for a model without bound_ik_by_iterations
     max_acceleration: float | None = None  # m/s²: the EE's peak acceleration in a timed move (a held load), None: free
     _answers: dict[tuple[bytes, bytes], IKResult] = field(default_factory=dict, init=False, repr=False)  # see ik()
+    _lines: dict[bytes, Plan] = field(default_factory=dict, init=False, repr=False)  # see straight_path()
 
     def ik(self, T: np.ndarray, seed: np.ndarray) -> IKResult:
         """IK of the EE pose ``T`` (4x4, world) from ``seed`` (rad or m), remembered for the mover's
@@ -123,10 +124,17 @@ class ArmMover:
         return self.straight_path(q0, T_goal)[0]
 
     def straight_path(self, q0: np.ndarray, T_goal: np.ndarray) -> tuple[np.ndarray, JointSpline]:
-        """:meth:`straight_waypoints` and the joint path through them (for ``MinJerkPath``)."""
-        from robocfg.motion.straight_line import straight_line_path
+        """:meth:`straight_waypoints` and the joint path through them (for ``MinJerkPath``). The
+        episode's last line to the same ``T_goal`` (exact bytes) is checked from ``q0`` first and
+        kept if it passes (:func:`~robocfg.motion.straight_line.straight_line_plan`): the grasp
+        choice checks the approach from the pre-grasp answer, the approach then starts where the
+        pre-grasp move converged."""
+        from robocfg.motion.straight_line import straight_line_plan
 
-        return straight_line_path(self.model, q0, T_goal, *self._line_calls())
+        key = np.asarray(T_goal, dtype=float).tobytes()
+        W, path, self._lines[key] = straight_line_plan(self.model, q0, T_goal, *self._line_calls(),
+                                                       earlier=self._lines.get(key))
+        return W, path
 
     def straight_end(self, q0: np.ndarray, T_goal: np.ndarray) -> np.ndarray:
         """Where a straight line from FK(q0) to ``T_goal`` would end, without building and checking

@@ -61,6 +61,7 @@ _COS_TOLERANCE = math.cos(ANGLE_TOLERANCE)
 Solve = Callable[[np.ndarray, np.ndarray], "IKResult"]  # (world_T_ee, seed) -> IK answer
 Fail = Callable[[str], Exception]  # reason -> the error to raise
 Unreachable = Callable[["IKResult", str], Exception]  # (answer, " at X % of the straight line") -> error
+Plan = tuple[list[float], list[np.ndarray]]  # a checked line's waypoints: (line fractions, joints), first to last
 
 
 class _Line:
@@ -164,9 +165,24 @@ def straight_line_path(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray
     """Joint waypoints (k, n) from ``q0`` to an IK answer of ``T_goal`` whose played path (the
     second item: :func:`joint_path` of them, for ``MinJerkPath(path=...)``) keeps the EE on the
     straight line (see the module docstring); raises ``fail(reason)`` or ``unreachable``."""
+    return straight_line_plan(model, q0, T_goal, ik, fail, unreachable)[:2]
+
+
+def straight_line_plan(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray, ik: Solve,
+                       fail: Fail, unreachable: Unreachable,
+                       earlier: Plan | None = None) -> tuple[np.ndarray, JointSpline, Plan]:
+    """:func:`straight_line_path` and the line's plan (its waypoints' line fractions and joints).
+    ``earlier``: the plan of a line to the same ``T_goal`` from a start near ``q0`` (e.g. checked
+    before the arm moved to that start): its waypoints after the first, behind ``q0``, are kept
+    when the path through them passes the FK check as it is (no piece to cut: no IK at all, the
+    last waypoint an answer of ``T_goal`` itself); else the line is planned afresh."""
     q0 = np.asarray(q0, dtype=float)
     line = _Line(model, q0, T_goal, ik)
     try:
+        if earlier is not None and line.length >= MIN_PIECE:
+            kept = _as_checked(line, earlier[0], [q0, *earlier[1][1:]])
+            if kept is not None:
+                return kept
         try:
             return _first_guess(line, q0, fail)
         except (_Broken, _Unreachable):  # the old way: each point from the last (where it breaks, first)
@@ -182,7 +198,7 @@ def straight_line_path(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray
         raise fail(f"no continuous IK along the straight line ({exc.reason})") from None
 
 
-def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, JointSpline]:
+def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, JointSpline, Plan]:
     """The line from few IK solves (module docstring), refined; raises _Broken or _Unreachable
     for the old way to try, ``fail`` where the old way would have failed the same."""
     if line.length < MIN_PIECE:  # too short to cut: the goal's answer, checked for a jump
@@ -190,7 +206,7 @@ def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, J
         jump = joint_travel(q0, q1)
         if jump > MAX_JOINT_JUMP:
             raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at 100%)")
-        return np.asarray([q0, q1]), joint_path(np.asarray([q0, q1]))[1]
+        return np.asarray([q0, q1]), joint_path(np.asarray([q0, q1]))[1], ([0.0, 1.0], [q0, q1])
     S, Q = _start(line, q0, fail)
     if S[-1] < 1.0:  # the rest: IK at its end from the last answer, then at the cuts between, seeded by interpolation
         a, qa = S[-1], Q[-1]
@@ -242,17 +258,39 @@ def straight_line_end(model: KinematicModel, q0: np.ndarray, T_goal: np.ndarray,
     return q1
 
 
-def _refine(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarray, JointSpline]:
+def _as_checked(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarray, JointSpline, Plan] | None:
+    """The waypoints ``Q`` (at line fractions ``S``), the path through them and their plan when
+    every piece passes :func:`_refine`'s check as it is; None when a piece would be cut or kept
+    out of tolerance, or an answer repeats."""
+    W = np.asarray(Q)
+    W_kept, path, knots = joint_path_knots(W)
+    if len(W_kept) != len(W):
+        return None
+    dist, turned, jumps = _pieces(line, W, path, knots, S)
+    if max(dist) > POSITION_TOLERANCE or any(turned) or max(jumps) > MAX_JOINT_JUMP:
+        return None
+    return W, path, (S, Q)
+
+
+def _pieces(line: _Line, W: np.ndarray, path: JointSpline, knots: list[float],
+            S: list[float]) -> tuple[list[float], list[bool], list[float]]:
+    """Per piece of the path through ``W``: :meth:`_Line.errors` and the largest joint step (rad)."""
+    dist, turned = line.errors(path, knots, S)
+    jumps = [max(abs(b - a) for a, b in zip(qa, qb, strict=True)) for qa, qb in pairwise(W.tolist())]
+    return dist, turned, jumps
+
+
+def _refine(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarray, JointSpline, Plan]:
     """Cut the failing pieces of the path through ``Q`` (at line fractions ``S``) until every
-    piece passes or is ``MIN_PIECE`` short; raises _Broken for a short piece that breaks the line."""
+    piece passes or is ``MIN_PIECE`` short; raises _Broken for a short piece that breaks the line.
+    Returns the waypoints, the path through them and their plan ``(S, Q)``."""
     kept: set[tuple[float, float]] = set()  # MIN_PIECE pieces within GIVE_UP_DISTANCE, accepted
     while True:
         W = np.asarray(Q)
         W_kept, path, knots = joint_path_knots(W)
         if len(W_kept) != len(W):  # an answer repeated (the line does not move the joints): nothing to check
-            return W, path
-        dist, turned = line.errors(path, knots, S)
-        jumps = [max(abs(b - a) for a, b in zip(qa, qb, strict=True)) for qa, qb in pairwise(W.tolist())]
+            return W, path, (S, Q)
+        dist, turned, jumps = _pieces(line, W, path, knots, S)
         new_S, new_Q, cut = [S[0]], [Q[0]], False
         for i in range(len(S) - 1):
             a, b = S[i], S[i + 1]
@@ -272,5 +310,5 @@ def _refine(line: _Line, S: list[float], Q: list[np.ndarray]) -> tuple[np.ndarra
             new_S.append(b)
             new_Q.append(Q[i + 1])
         if not cut:
-            return W, path
+            return W, path, (S, Q)
         S, Q = new_S, new_Q
