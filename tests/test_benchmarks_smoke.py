@@ -51,3 +51,11 @@ def test_control_swap_runs_a_pair_against_a_checkout():
               "--time", "robocfg.motion.moves:ArmMover.converge", "--episodes", "1"], timeout=600)
     assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr[-3000:]
     assert "1 episode pairs" in p.stdout and "inside the --time functions" in p.stdout, p.stdout
+
+
+def test_step_loop_runs_its_variants_against_a_checkout():
+    p = _run(["benchmarks/bench_step_loop.py", "--steps", "40", "--rounds", "2", "--base", str(ROOT)], timeout=600)
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr[-3000:]
+    rows = [line.split()[0] for line in p.stdout.splitlines() if line.startswith("  ") and " - " not in line]
+    assert rows[:2] == ["floor", "play"] and "checks" in rows, p.stdout
+    assert "base play - play: paired" in p.stdout, p.stdout
