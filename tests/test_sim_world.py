@@ -185,3 +185,60 @@ def test_a_body_spawned_again_reuses_its_shapes(tmp_path):
         w.add_body(ball.model_copy(update={"name": "big", "size": [0.05]}))
         assert len(w.shape_cache) == 3
         assert np.allclose(w.body_pose("big")[0], [0.5, -0.3, 0.03])
+
+
+def test_a_body_placed_again_is_what_a_new_body_would_be(tmp_path):
+    """World.place_body puts a body made from the same shape where another Body says, at rest, with
+    its mass (inertia recomputed) and friction: the same pose, velocity and dynamics PyBullet
+    gives a body newly made from that Body (a box, a cylinder, a scaled mesh file); a URDF body or
+    one without mass is refused (see robocfg.sim.bodies.can_reset)."""
+    task = make_task(tmp_path, PANDA)
+    with World(task) as w:
+        for kind in (dict(shape="box", size=[0.04, 0.06, 0.08]), dict(shape="cylinder", size=[0.02, 0.09]),
+                     dict(shape="mesh", size=[0.8, 0.8, 0.8], mesh="pybullet_data://duck_vhacd.obj")):
+            first = Body(name="obj", mass=0.2, friction=0.7, position=[0.5, 0.2, 0.3], euler_deg=[0, 0, 30], **kind)
+            again = first.model_copy(update={"mass": 0.137, "friction": 0.45, "position": [0.42, -0.13, 0.05],
+                                             "euler_deg": [5.0, -3.0, 71.0]})
+            obj = w.add_body(first)
+            w.step(30)  # moving, touching the ground: the placed body must come to rest where it is put
+            assert np.linalg.norm(w.body_velocity(obj)[0]) > 0.1
+            assert w.place_body(again) == obj == w.bodies["obj"]
+            new = w.add_body(again.model_copy(update={"name": "new"}))
+            for a, b in ((obj, new),):
+                assert p.getBasePositionAndOrientation(a, physicsClientId=w.client) == \
+                    p.getBasePositionAndOrientation(b, physicsClientId=w.client)
+                assert p.getBaseVelocity(a, physicsClientId=w.client) == ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+                info_a, info_b = (p.getDynamicsInfo(i, -1, physicsClientId=w.client) for i in (a, b))
+                assert info_a == info_b and info_a[0] == 0.137 and info_a[1] == 0.45
+            w.remove_body("obj")
+            w.remove_body("new")
+        box = Body(name="fixed", shape="box", size=[0.1, 0.1, 0.1], mass=0.1, position=[0.5, 0, 0.5])
+        w.add_body(box)
+        with pytest.raises(ValueError, match="fixed"):
+            w.place_body(box.model_copy(update={"mass": 0.0}))
+        duck = Body(name="duck", shape="mesh", size=[1, 1, 1], mesh="pybullet_data://duck_vhacd.urdf", position=[0.5, 0, 0.5])
+        w.add_body(duck)
+        with pytest.raises(ValueError, match="duck"):
+            w.place_body(duck)
+
+
+def test_a_placed_bodys_orientation_has_a_new_bodys_bits(tmp_path):
+    """createMultiBody stores an orientation that went through a rotation matrix: place_body gives
+    the same bits for random orientations, yaw-only ones (the episodes' turns) among them."""
+    task = make_task(tmp_path, PANDA)
+    rng = np.random.default_rng(5)
+    with World(task) as w:
+        body = Body(name="obj", shape="box", size=[0.04, 0.06, 0.08], mass=0.1, position=[0.5, 0.0, 2.0])
+        w.add_body(body)
+        for n in range(300):
+            q = rng.normal(size=4)
+            q /= np.linalg.norm(q)
+            if n % 3 == 0:
+                yaw = rng.uniform(-np.pi, np.pi)
+                q = np.array([0.0, 0.0, np.sin(yaw / 2), np.cos(yaw / 2)])
+            turned = body.model_copy(update={"quat_xyzw": [float(v) for v in q], "position": [0.5, 0.0, 2.0 + n]})
+            w.place_body(turned)
+            new = w.add_body(turned.model_copy(update={"name": "new"}))
+            assert p.getBasePositionAndOrientation(w.bodies["obj"], physicsClientId=w.client) == \
+                p.getBasePositionAndOrientation(new, physicsClientId=w.client)
+            w.remove_body("new")

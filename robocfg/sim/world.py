@@ -51,7 +51,14 @@ from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
 from robocfg.sim import renderer
-from robocfg.sim.bodies import ShapeCache, spawn_body, spawn_ground, spawn_pedestal, spawn_table
+from robocfg.sim.bodies import (
+    ShapeCache,
+    reset_body,
+    spawn_body,
+    spawn_ground,
+    spawn_pedestal,
+    spawn_table,
+)
 from robocfg.sim.gripper import Gripper, make_gripper
 from robocfg.sim.loading import filter_gripper_linkage, load_robot_urdf
 from robocfg.sim.mimic import MimicGears
@@ -241,6 +248,16 @@ class World(SceneQueries):
             self.remove_body(body.name)
         bid = spawn_body(self.client, body, self.task.path.parent, static=static, cache=self.shape_cache)
         self._register(body.name, bid, dynamic=not static and body.mass > 0)
+        self._warn_overlap(body.name)
+        return bid
+
+    def place_body(self, body: Body) -> int:
+        """Put the body registered as ``body.name`` (added by :meth:`add_body` from a body of the
+        same shape, size, mesh and colour, with mass) where ``body`` says, at rest, with its mass
+        and friction (:func:`~robocfg.sim.bodies.reset_body`): what :meth:`add_body` would make
+        of ``body``, without creating a new body; returns its id."""
+        bid = self.body_id(body.name)
+        reset_body(self.client, bid, body)
         self._warn_overlap(body.name)
         return bid
 
