@@ -242,3 +242,20 @@ def test_a_placed_bodys_orientation_has_a_new_bodys_bits(tmp_path):
             assert p.getBasePositionAndOrientation(w.bodies["obj"], physicsClientId=w.client) == \
                 p.getBasePositionAndOrientation(new, physicsClientId=w.client)
             w.remove_body("new")
+
+
+def test_a_parked_body_is_left_out_of_the_fitted_camera(tmp_path):
+    """A body waiting out of the scene (park_body) does not move the scene camera; once placed it
+    is part of the scene again."""
+    from robocfg.sim.record_camera import scene_camera
+
+    task = make_task(tmp_path, PANDA)
+    with World(task) as w:
+        before = scene_camera(w)
+        cube = Body(name="obj", shape="box", size=[0.05, 0.05, 0.05], mass=0.1, position=[0.0, 0.0, 100.0])
+        w.add_body(cube)
+        assert scene_camera(w) != before  # 100 m up: the fit takes it in
+        w.park_body("obj")
+        assert scene_camera(w) == before
+        w.place_body(cube.model_copy(update={"position": [0.5, 0.1, 0.025]}))
+        assert w.parked == set() and scene_camera(w) != before

@@ -116,6 +116,12 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         self.parked = can_reset(obj) and self.params.randomize.mass_scale < 1  # every episode's mass > 0
         if self.parked:
             self.world.add_body(obj.model_copy(update={"position": [0.0, 0.0, PARK_HEIGHT]}))
+            self.world.park_body(obj.name)
+
+    def _reset(self) -> None:
+        super()._reset()
+        if self.parked:  # the restore put it back where it waits (a recorder's camera leaves it out)
+            self.world.park_body(self.params.object.name)
 
     def _machine(self, k: int, recorder: FrameRecorder | None) -> _StateMachine:
         """Episode ``k``'s state machine in the restored world (it spawns the object)."""

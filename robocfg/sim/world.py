@@ -109,6 +109,7 @@ class World(SceneQueries):
         self.play_through: Callable[[ArmHandle, list, list, Callable[[], None] | None], bool] | None = None
         self.warnings: list[str] = []
         self.bodies: dict[str, int] = {}
+        self.parked: set[int] = set()  # bodies waiting out of the scene (park_body): no camera is fitted to them
         self.shape_cache = ShapeCache()  # shapes of bodies added per episode, reused (PyBullet never frees them)
         self.robots: list[RobotHandle] = []
         self.mimic: dict[int, MimicGears] = {}
@@ -258,8 +259,14 @@ class World(SceneQueries):
         of ``body``, without creating a new body; returns its id."""
         bid = self.body_id(body.name)
         reset_body(self.client, bid, body)
+        self.parked.discard(bid)
         self._warn_overlap(body.name)
         return bid
+
+    def park_body(self, name: str) -> None:
+        """Mark body ``name`` as waiting out of the scene until :meth:`place_body` (a camera
+        fitted to the scene leaves it out: it is not yet part of the episode)."""
+        self.parked.add(self.body_id(name))
 
     def remove_body(self, name: str) -> None:
         bid = self.body_id(name)
