@@ -88,6 +88,8 @@ def _play_bare(world: World, arm: ArmHandle, plan: MotorPlan, q: np.ndarray, qd:
     try:
         # positional: setJointMotorControlArray(body, joints, mode, targetPositions,
         # targetVelocities, forces, positionGains, velocityGains, physicsClientId)
+        # Two copies of one loop, with and without the physics clock, so that the untimed one (a
+        # user's run) tests nothing per step for it; keep the two in step.
         if timed:
             for row, speeds in zip(unpack(q.data), unpack(qd.data)):  # noqa: B905 - shapes checked by play_rows
                 send(body, idx, mode, row, speeds, force, kp, kd, client)
