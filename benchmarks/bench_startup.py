@@ -1,7 +1,7 @@
 """Start-up of a fresh robocfg process: CLI commands, importing the pick-place runner, and the
 time until a pick-place process's world is ready and its first episode is done.
 
-Usage: python benchmarks/bench_startup.py [--runs 15] [--only help,run-help,...] [--json out.json]
+Usage: python benchmarks/bench_startup.py [--runs 15] [--only help,run-help,...,first-episode,library-floor] [--json out.json]
 
 Every row is a fresh process (``python -m robocfg`` with the interpreter running this script),
 run in ``--root`` (default: this script's checkout; the current directory comes first on the
@@ -24,6 +24,13 @@ warm-up run (file cache). Rows:
   ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS`` = 1, unless set in this environment: a pool's fork
   server sets them, Ray sets ``OMP_NUM_THREADS``); ``--math-threads default`` leaves the
   libraries their default (a thread per core each for numpy's and scipy's OpenBLAS).
+* ``library-floor``: the same job without robocfg, the floor any tool on these libraries pays: a
+  process that imports numpy, PyYAML, pydantic, pinocchio and pybullet (*imports*), then connects
+  a DIRECT client without its renderer, loads the shipped task's robot URDF as the world does
+  (inertia from the file, no visual shapes, self-collision) and builds its pinocchio model
+  (*world*), timed from just before the spawn as ``first-episode`` is. ``first-episode: world``
+  minus this row's *world* is what robocfg's own code adds to the fixed start (config loading and
+  checks, its modules, the scene, the kinematic model's set-up, the reach check).
 
 For each row: min / median / max wall time and the median CPU time of the child (user + sys:
 what the wall time would be on an idle core). The machine's 1-minute load average is printed:
@@ -91,6 +98,25 @@ mark("episode 1")
 session.close()
 print(json.dumps(marks))
 """
+# the library-floor child: argv[1] is the robot URDF the shipped task's world loads
+_FLOOR = """
+import json, sys, time
+marks = {}
+def mark(name):
+    marks[name] = (time.time(), time.process_time())
+import numpy, yaml, pydantic, pinocchio, pybullet as p
+mark("imports")
+urdf = sys.argv[1]
+c = p.connect(p.DIRECT)
+p.unloadPlugin(p.loadPlugin("tinyRendererPlugin", physicsClientId=c), physicsClientId=c)
+flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_IGNORE_VISUAL_SHAPES | p.URDF_USE_SELF_COLLISION
+p.loadURDF(urdf, useFixedBase=True, flags=flags | p.URDF_USE_SELF_COLLISION_EXCLUDE_ALL_PARENTS, physicsClientId=c)
+with open(urdf) as f:
+    pinocchio.buildModelFromXML(f.read())
+mark("world")
+print(json.dumps(marks))
+"""
+FLOOR_MARKS = ("imports", "world")
 FIRST_MARKS = ("imports", "task", "world", "episode 0")
 FIRST_GOAL = {"world": 0.5}  # the issue's goal for the fixed start
 
@@ -147,6 +173,34 @@ def _first_episode(runs: int, roots: list[Path], env: dict[str, str] | None = No
     return out
 
 
+def _task_urdf() -> str:
+    """The robot URDF file the shipped pick-place task's world hands to PyBullet."""
+    from robocfg.sim.quiet import quiet_import
+
+    quiet_import()  # pybullet's build banner stays out of the table
+    from robocfg.checks.task import load_task
+    from robocfg.config import catalog
+    from robocfg.sim.loading import prepared_urdf
+
+    return str(prepared_urdf(load_task(catalog.find("tasks", "pick_place")).robots[0]))
+
+
+def _floor(runs: int, env: dict[str, str] | None) -> dict[str, tuple[list, list]]:
+    """mark → (wall, CPU) samples of the library-floor child (in this checkout's folder: it imports
+    no robocfg, so every checkout has the same floor)."""
+    argv = [sys.executable, "-c", _FLOOR, _task_urdf()]
+    out: dict[str, tuple[list, list]] = {m: ([], []) for m in FLOOR_MARKS}
+    _timed(argv, None, env)  # warm-up
+    for _ in range(runs):
+        t0 = time.time()
+        _, _, stdout = _timed(argv, None, env)
+        marks = json.loads(stdout.strip().splitlines()[-1])
+        for m in FLOOR_MARKS:
+            out[m][0].append(marks[m][0] - t0)
+            out[m][1].append(marks[m][1])
+    return out
+
+
 def _samples(argv: list[str], runs: int, roots: list[Path]) -> dict[Path, tuple[list, list]]:
     out: dict[Path, tuple[list, list]] = {r: ([], []) for r in roots}
     for r in roots:
@@ -184,8 +238,8 @@ def main() -> None:
     args = ap.parse_args()
     _set_root(args.root.resolve())
     roots = [ROOT] + ([args.against.resolve()] if args.against is not None else [])
-    only = [s for s in args.only.split(",") if s] or [*CASES, "first-episode"]
-    unknown = set(only) - {*CASES, "first-episode"}
+    only = [s for s in args.only.split(",") if s] or [*CASES, "first-episode", "library-floor"]
+    unknown = set(only) - {*CASES, "first-episode", "library-floor"}
     if unknown:
         sys.exit(f"unknown rows: {', '.join(sorted(unknown))}")
     print(f"load average before: {os.getloadavg()[0]:.2f}   runs: {args.runs}   python: {sys.version.split()[0]}   "
@@ -199,6 +253,10 @@ def main() -> None:
             for m in (*FIRST_MARKS, "episode 1 alone"):
                 rows += _rows(f"first-episode: {m}", {r: (w[m], c[m]) for r, (w, c) in first.items()},
                               FIRST_GOAL.get(m))
+            continue
+        if label == "library-floor":
+            for m, (wall, cpu) in _floor(args.runs, _worker_env(args.math_threads)).items():
+                rows.append(_row(f"library floor: {m}", wall, cpu, None))
             continue
         argv, goal = CASES[label]
         rows += _rows(label, _samples(argv, args.runs, roots), goal)

@@ -59,3 +59,14 @@ def test_step_loop_runs_its_variants_against_a_checkout():
     rows = [line.split()[0] for line in p.stdout.splitlines() if line.startswith("  ") and " - " not in line]
     assert rows[:2] == ["floor", "play"] and "checks" in rows, p.stdout
     assert "base play - play: paired" in p.stdout, p.stdout
+
+
+def test_startup_library_floor_runs():
+    """The floor child (no robocfg: the libraries, a DIRECT client, the task's robot, its pinocchio
+    model) runs and reports both marks, after the imports and after the world."""
+    p = _run(["benchmarks/bench_startup.py", "--runs", "1", "--only", "library-floor"], timeout=300)
+    assert p.returncode == 0 and "Traceback" not in p.stderr, p.stderr[-3000:]
+    rows = [line.split() for line in p.stdout.splitlines() if line.startswith("library floor:")]
+    assert [r[2] for r in rows] == ["imports", "world"], p.stdout
+    imports, world = (float(r[4]) for r in rows)  # median wall s
+    assert 0 < imports <= world, p.stdout
