@@ -40,7 +40,6 @@ __all__ = ["EpisodeSetup", "PickPlaceRunner", "_StateMachine", "_Tools", "episod
            "run_pick_place"]
 
 PickPlaceTiming = BatchTiming
-PARK_HEIGHT = 100.0  # m: where the session's object waits between episodes (above the scene, touching nothing)
 
 
 def episode_setup(params: PickPlaceParams, seed: int, k: int) -> EpisodeSetup:
@@ -82,7 +81,6 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
         from robocfg.grasp.gripper_model import measure_gripper
         from robocfg.kinematics.model import KinematicModel
         from robocfg.motion.limits import limits_from_robot
-        from robocfg.sim.bodies import can_reset
 
         robot = self.task.robots[0]
         self.arm_cfg = robot.config.arm(self.options.arm)
@@ -107,32 +105,15 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
                             reactive_drive(robot, self.world, self.arm_cfg.name, self.params, shape),
                             planned_drive(robot, self.world, model, self.params), shape=shape, boxes=boxes,
                             pad_force=force)
-        # The episodes' object, made once (after the planner and the controller have read the
-        # scene) and parked above it before the snapshot: each episode puts it in place
-        # (World.place_body) instead of removing a body and creating one (PyBullet serialises and
-        # parses a new body whole: ≈ 1 M instructions). A body that may be static, or a URDF, is
-        # made per episode, as before.
-        obj = self.params.object
-        self.parked = can_reset(obj) and self.params.randomize.mass_scale < 1  # every episode's mass > 0
-        if self.parked:
-            self.world.add_body(obj.model_copy(update={"position": [0.0, 0.0, PARK_HEIGHT]}))
-            self.world.park_body(obj.name)
-
-    def _reset(self) -> None:
-        super()._reset()
-        if self.parked:  # the restore put it back where it waits (a recorder's camera leaves it out)
-            self.world.park_body(self.params.object.name)
-
     def _machine(self, k: int, recorder: FrameRecorder | None) -> _StateMachine:
-        """Episode ``k``'s state machine in the restored world (it spawns the object)."""
+        """Episode ``k``'s state machine in the restored world (it spawns the object, removed
+        before the next restore). The object is a new body each episode, not one made once and
+        put in place (World.place_body): a body made before the snapshot and placed gave episode
+        0 of ``pick_place --robot xarm6 --seed 5`` other physics when it ran first in a session
+        than after another episode (tests/test_engine.py)."""
         setup = episode_setup(self.params, self.seed, k)
-        if self.parked:
-            body_id = self.world.place_body(setup.body)
-        else:
-            self.remove_after_episode(setup.body.name)
-            body_id = None
-        return _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k),
-                             body_id=body_id)
+        self.remove_after_episode(setup.body.name)
+        return _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k))
 
     def episode(self, k: int, recorder: FrameRecorder | None) -> EpisodeResult:
         if self.blocked is not None:
