@@ -293,3 +293,39 @@ def test_straight_end_fails_where_the_lines_first_points_fail():
     T_far[:3, 3] = [1.6, -0.3, 0.25]
     with pytest.raises(MoveFailed, match=r"unreachable at 100% of the straight line"):
         mover.straight_end(nearest, T_far)
+
+
+@pytest.mark.parametrize("start", ["on the line at 30 %", "on the line at 60 %", "same pose, other joints",
+                                   "pushed 2 cm"])
+def test_a_remembered_line_from_a_very_different_start_stays_on_the_line(kin, start, monkeypatch):
+    """A second line to a goal the mover has planned a line to, from a start the first line did not
+    begin at (partway along it, the same EE pose with other joints, the arm pushed aside): either
+    the first line's waypoints are kept and the played path stays on the new line within
+    tolerance and never runs back along it, or the line is the fresh plan, bit for bit."""
+    T_a = np.block([[DOWN, np.array([[0.45], [0.05], [0.35]])], [np.zeros((1, 3)), 1.0]])
+    q_a = kin.ik(T_a, seed_q=kin.home, frame="ee").q
+    T_goal = kin.fk(q_a, "ee")
+    T_goal[:3, 3] += (0.0, 0.0, -0.12)
+    mover, calls, counted = _counting_mover(kin)
+    _, path_a = mover.straight_path(q_a, T_goal)
+    if start.startswith("on the line"):
+        q_b = path_a(np.array([0.3 if "30" in start else 0.6]))[0]
+    elif start == "same pose, other joints":
+        q_b = kin.ik(T_a, seed_q=q_a + np.random.default_rng(1).normal(0.0, 0.6, kin.nq), frame="ee").q
+        assert np.abs(q_b - q_a).max() > 0.1
+    else:
+        q_b = kin.ik(T_a @ np.block([[np.eye(3), np.array([[0.02], [0.0], [0.01]])], [np.zeros((1, 3)), 1.0]]),
+                     seed_q=q_a, frame="ee").q
+    monkeypatch.setattr(kin, "ik", counted)
+    W_b, path_b = mover.straight_path(q_b, T_goal)
+    monkeypatch.undo()
+    d, a = _line_error(kin, q_b, T_goal, path_b)
+    assert d <= 1.1 * sl.POSITION_TOLERANCE and a <= 1.1 * sl.ANGLE_TOLERANCE, (d, math.degrees(a))
+    assert np.allclose(kin.fk(W_b[-1], "ee"), T_goal, atol=1e-4)
+    p0, p1 = kin.fk(q_b, "ee")[:3, 3], T_goal[:3, 3]
+    along = [float((kin.fk(q, "ee")[:3, 3] - p0) @ (p1 - p0)) / float(np.linalg.norm(p1 - p0))
+             for q in path_b(np.linspace(0.0, 1.0, 400))]
+    assert max(np.maximum.accumulate(along) - along) < 1e-3  # no running back along the line
+    if calls:  # planned afresh: the plan from q_b alone
+        W_fresh = ArmMover(None, None, kin, None).straight_waypoints(q_b, T_goal)  # type: ignore[arg-type]
+        assert W_b.tobytes() == W_fresh.tobytes()
