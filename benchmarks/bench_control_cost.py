@@ -92,7 +92,6 @@ BUCKETS = (  # (module, class or None for a module function, function, label); e
     ("robocfg.runners.pick_place_machine", "_StateMachine", "_support_height", "support ray casts"),
     ("robocfg.engine.session", "EpisodeSession", "_reset", "world restore"),
     ("robocfg.sim.world", "World", "add_body", "object spawn"),
-    ("robocfg.sim.world", "World", "place_body", "object spawn"),
     ("robocfg.runners.pick_place", None, "episode_setup", "episode set-up"),
     ("robocfg.runners.pick_place_machine", "_StateMachine", "__init__", "episode set-up"),
     ("robocfg.sim.robot", "RobotHandle", "link_pose", "state reads"),

@@ -105,12 +105,13 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
                             reactive_drive(robot, self.world, self.arm_cfg.name, self.params, shape),
                             planned_drive(robot, self.world, model, self.params), shape=shape, boxes=boxes,
                             pad_force=force)
+
     def _machine(self, k: int, recorder: FrameRecorder | None) -> _StateMachine:
         """Episode ``k``'s state machine in the restored world (it spawns the object, removed
         before the next restore). The object is a new body each episode, not one made once and
-        put in place (World.place_body): a body made before the snapshot and placed gave episode
-        0 of ``pick_place --robot xarm6 --seed 5`` other physics when it ran first in a session
-        than after another episode (tests/test_engine.py)."""
+        reset in place: a body made before the snapshot and reset gave episode 0 of
+        ``pick_place --robot xarm6 --seed 5`` other physics when it ran first in a session than
+        after another episode (tests/test_engine.py)."""
         setup = episode_setup(self.params, self.seed, k)
         self.remove_after_episode(setup.body.name)
         return _StateMachine(self.world, self.handle, self.tools, self.params, setup, recorder, self.log_for(k))

@@ -6,8 +6,6 @@ A Body's ``position`` is its centre (centre of mass for primitives); a Table's a
 
 from __future__ import annotations
 
-import math
-from collections.abc import Sequence
 from pathlib import Path
 
 import pybullet as p
@@ -94,65 +92,6 @@ def spawn_body(client: int, body: Body, base_dir: Path, static: bool = False, ca
         bid = p.createMultiBody(mass, col, vis, body.position, quat, physicsClientId=client)
     p.changeDynamics(bid, -1, lateralFriction=body.friction, physicsClientId=client)
     return bid
-
-
-def reset_body(client: int, bid: int, body: Body) -> None:
-    """Put body ``bid``, made by :func:`spawn_body` from a body of the same primitive or mesh
-    file (not a URDF: see :func:`can_reset`), size and colour, where ``body`` says: its pose, at
-    rest, with ``body``'s mass (PyBullet recomputes the inertia from the shape, as for a new body)
-    and lateral friction — what :func:`spawn_body` would make of ``body``, without creating a body
-    (``createMultiBody`` serialises and parses the whole body each time).
-
-    The orientation is the one a new body gets: ``createMultiBody`` passes the quaternion through
-    a rotation matrix (Bullet's ``btTransform``), which can move its last bits, and
-    ``resetBasePositionAndOrientation`` stores what it is given differently; given the round
-    trip's quaternion (:func:`matrix_round_trip`) it stores the new body's bits (tested on random
-    orientations against new bodies, ``tests/test_sim_world.py``)."""
-    if not can_reset(body):
-        raise ValueError(f"body {body.name!r}: only a primitive or mesh-file body with mass is put in place again")
-    pos = [float(v) for v in body.position]
-    p.resetBasePositionAndOrientation(bid, pos, matrix_round_trip(body.quaternion_xyzw()), physicsClientId=client)
-    p.resetBaseVelocity(bid, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], physicsClientId=client)
-    p.changeDynamics(bid, -1, mass=body.mass, lateralFriction=body.friction, physicsClientId=client)
-
-
-def matrix_round_trip(q: Sequence[float]) -> list[float]:
-    """Quaternion ``q`` (x, y, z, w) turned into Bullet's rotation matrix and back, with Bullet's
-    double-precision arithmetic in its order (``btMatrix3x3::setRotation``, ``getRotation``)."""
-    x, y, z, w = (float(v) for v in q)
-    d = x * x + y * y + z * z + w * w
-    s = 2.0 / d
-    xs, ys, zs = x * s, y * s, z * s
-    wx, wy, wz = w * xs, w * ys, w * zs
-    xx, xy, xz = x * xs, x * ys, x * zs
-    yy, yz, zz = y * ys, y * zs, z * zs
-    m = ((1.0 - (yy + zz), xy - wz, xz + wy), (xy + wz, 1.0 - (xx + zz), yz - wx), (xz - wy, yz + wx, 1.0 - (xx + yy)))
-    out = [0.0, 0.0, 0.0, 0.0]
-    trace = m[0][0] + m[1][1] + m[2][2]
-    if trace > 0.0:
-        r = math.sqrt(trace + 1.0)
-        out[3] = r * 0.5
-        r = 0.5 / r
-        out[0] = (m[2][1] - m[1][2]) * r
-        out[1] = (m[0][2] - m[2][0]) * r
-        out[2] = (m[1][0] - m[0][1]) * r
-    else:
-        i = (2 if m[1][1] < m[2][2] else 1) if m[0][0] < m[1][1] else (2 if m[0][0] < m[2][2] else 0)
-        j, k = (i + 1) % 3, (i + 2) % 3
-        r = math.sqrt(m[i][i] - m[j][j] - m[k][k] + 1.0)
-        out[i] = r * 0.5
-        r = 0.5 / r
-        out[3] = (m[k][j] - m[j][k]) * r
-        out[j] = (m[j][i] + m[i][j]) * r
-        out[k] = (m[k][i] + m[i][k]) * r
-    return out
-
-
-def can_reset(body: Body) -> bool:
-    """Whether :func:`reset_body` can stand for :func:`spawn_body` with ``body``: a body with mass
-    made by ``createMultiBody`` (a primitive or a mesh file; a URDF's base frame is its inertial
-    frame, which may sit off the link frame ``loadURDF`` places)."""
-    return body.mass > 0 and not (body.shape == "mesh" and (body.mesh or "").endswith(".urdf"))
 
 
 def spawn_ground(client: int, visuals: bool = True) -> int:

@@ -71,11 +71,11 @@ def _facing_work(base, work) -> tuple[float, float, float]:
 def scene_camera(world, size: tuple[int, int] = (320, 240), markers=(), direction=DEFAULT_DIRECTION,
                  margin: float = 1.1) -> CameraView:
     """A camera fitted (see :func:`fit_camera`) to the boxes of every robot link and body of the
-    world except the ground and parked bodies (``World.park_body``), and the markers: a tabletop
-    arm and a KR210 on its pedestal both fill the frame. The robot's boxes are taken at its current (start) pose. With a pick-place
+    world except the ground, and the markers: a tabletop arm and a KR210 on its pedestal both
+    fill the frame. The robot's boxes are taken at its current (start) pose. With a pick-place
     task the default direction is turned so the object and the place target face the camera."""
     c = world.client
-    skip = {getattr(world, "bodies", {}).get("ground"), *getattr(world, "parked", ())}
+    skip = {getattr(world, "bodies", {}).get("ground")}
     boxes = []
     for i in range(p.getNumBodies(physicsClientId=c)):
         bid = p.getBodyUniqueId(i, physicsClientId=c)

@@ -51,14 +51,7 @@ from robocfg.config.task import RobotMount
 from robocfg.errors import NotFound, PhysicsDiverged, RobocfgError, RunInterrupted
 from robocfg.geometry import quat_to_matrix
 from robocfg.sim import renderer
-from robocfg.sim.bodies import (
-    ShapeCache,
-    reset_body,
-    spawn_body,
-    spawn_ground,
-    spawn_pedestal,
-    spawn_table,
-)
+from robocfg.sim.bodies import ShapeCache, spawn_body, spawn_ground, spawn_pedestal, spawn_table
 from robocfg.sim.gripper import Gripper, make_gripper
 from robocfg.sim.loading import filter_gripper_linkage, load_robot_urdf
 from robocfg.sim.mimic import MimicGears
@@ -109,7 +102,6 @@ class World(SceneQueries):
         self.play_through: Callable[[ArmHandle, list, list, Callable[[], None] | None], bool] | None = None
         self.warnings: list[str] = []
         self.bodies: dict[str, int] = {}
-        self.parked: set[int] = set()  # bodies waiting out of the scene (park_body): no camera is fitted to them
         self.shape_cache = ShapeCache()  # shapes of bodies added per episode, reused (PyBullet never frees them)
         self.robots: list[RobotHandle] = []
         self.mimic: dict[int, MimicGears] = {}
@@ -251,22 +243,6 @@ class World(SceneQueries):
         self._register(body.name, bid, dynamic=not static and body.mass > 0)
         self._warn_overlap(body.name)
         return bid
-
-    def place_body(self, body: Body) -> int:
-        """Put the body registered as ``body.name`` (added by :meth:`add_body` from a body of the
-        same shape, size, mesh and colour, with mass) where ``body`` says, at rest, with its mass
-        and friction (:func:`~robocfg.sim.bodies.reset_body`): what :meth:`add_body` would make
-        of ``body``, without creating a new body; returns its id."""
-        bid = self.body_id(body.name)
-        reset_body(self.client, bid, body)
-        self.parked.discard(bid)
-        self._warn_overlap(body.name)
-        return bid
-
-    def park_body(self, name: str) -> None:
-        """Mark body ``name`` as waiting out of the scene until :meth:`place_body` (a camera
-        fitted to the scene leaves it out: it is not yet part of the episode)."""
-        self.parked.add(self.body_id(name))
 
     def remove_body(self, name: str) -> None:
         bid = self.body_id(name)
