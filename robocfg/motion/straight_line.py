@@ -5,7 +5,7 @@ positions, with the goal's orientation. Instead of an IK solve every few centime
 is cut into a first guess of ``FIRST_PIECE`` m pieces: IK at the line's end (seeded from q0),
 then at the inner cuts in order, each seeded by the joints interpolated between the previous
 point's answer (q0 for the first) and the end's (a continuation: the previous answer is nearer the
-IK curve than q0, 2.98 -> 2.67 LM iterations a cut on pick-place). The joint
+IK curve than q0, 3.02 -> 2.72 LM iterations a cut on pick-place, docs/benchmarks.md). The joint
 path that will actually be played — :func:`robocfg.motion.minjerk_path.joint_path` through the
 waypoints, the spline ``MinJerkPath`` times — is then sampled (every ``SAMPLE_STEP`` m of line,
 at least ``MIN_SAMPLES`` inside each piece) and its EE checked by FK (pinocchio, one batch):
