@@ -18,7 +18,8 @@ warm-up run (file cache). Rows:
   just before the spawn: *imports* (robocfg.engine and the task loader imported), *task* (loaded
   and checked), *world* (the world built: the **fixed start** a process pays before its first
   episode), *episode 0* done, and *episode 1* alone (what each further episode costs). The child
-  pauses the garbage collector first as those workers do (:mod:`robocfg.collector`; the engine
+  pauses the garbage collector first as those workers do (:mod:`robocfg.collector`, which also
+  installs the start-up code cache, :mod:`robocfg.startcache`, in ``ROBOCFG_CACHE_DIR``; the engine
   resumes it once the world is built; a checkout without that module, e.g. an older ``--root``,
   runs with its collector as it was) and runs with one math-library thread as they do (``OPENBLAS_NUM_THREADS``,
   ``OMP_NUM_THREADS``, ``MKL_NUM_THREADS`` = 1, unless set in this environment: a pool's fork

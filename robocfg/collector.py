@@ -34,6 +34,11 @@ puts the thresholds back with :func:`restore` as it returns, for a program or a 
 it), a pool worker (``robocfg.executors.pool``) and a Ray actor (``robocfg.executors.ray_pool``).
 A program that imports robocfg keeps its collector as it set it: :func:`resume` does nothing
 where :func:`pause` was not called.
+
+The same three marks drive the start-up code cache (:mod:`robocfg.startcache`: the compiled
+methods of the dataclasses the start creates, kept between processes): :func:`pause` installs it,
+:func:`resume` writes what is new (a pool worker ends with ``os._exit``, so not at exit),
+:func:`restore` writes and uninstalls it.
 """
 
 from __future__ import annotations
@@ -41,6 +46,8 @@ from __future__ import annotations
 import gc
 import os
 import sys
+
+from robocfg import startcache
 
 START_THRESHOLD = 100_000  # net new container objects between generation-0 collections during the start
 
@@ -58,6 +65,7 @@ def pause() -> None:
         _saved = gc.get_threshold()
         gc.set_threshold(START_THRESHOLD, _saved[1], _saved[2])
         _lazy_binding()
+    startcache.install()
 
 
 def _lazy_binding() -> None:
@@ -88,6 +96,7 @@ def resume() -> None:
         gc.set_threshold(*_saved)
         _saved = None
     _bind_now()
+    startcache.save()
 
 
 def restore() -> None:
@@ -103,6 +112,7 @@ def restore() -> None:
         gc.unfreeze()
         _froze = False
     _bind_now()
+    startcache.uninstall()
 
 
 def nanobind_loaded() -> bool:

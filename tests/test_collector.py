@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from robocfg import collector
+from robocfg import collector, startcache
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -25,6 +25,7 @@ def restored() -> Iterator[None]:
     yield
     if collector.paused():
         collector.resume()
+    startcache.uninstall()  # pause() installed the start-up code cache (robocfg.startcache)
     if gc.get_freeze_count() > frozen:
         gc.unfreeze()
     gc.set_threshold(*thresholds)

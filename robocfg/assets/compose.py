@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 from robocfg.assets.paths import Resolver, UnresolvedPath
 from robocfg.assets.urdf_xml import read_urdf_xml
+from robocfg.cachedir import cache_dir
 from robocfg.suggest import did_you_mean
 
 if TYPE_CHECKING:
@@ -87,15 +88,6 @@ class Composed:
     path: Path
     renamed: list[dict[str, str]] = field(default_factory=list)
     mount_joints: list[str] = field(default_factory=list)
-
-
-def cache_dir() -> Path:
-    """``$ROBOCFG_CACHE_DIR``, else ``$XDG_CACHE_HOME/robocfg``, else ``~/.cache/robocfg``."""
-    env = os.environ.get("ROBOCFG_CACHE_DIR")
-    if env:
-        return Path(env).expanduser()
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg).expanduser() if xdg else Path.home() / ".cache") / "robocfg"
 
 
 def compose(base: Path, parts: Sequence[Part], resolver: Resolver, out_dir: Path | None = None) -> Composed:
