@@ -5,7 +5,7 @@
 wrist; ``up`` is expressed in the same frame as the other two vectors.
 """
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import Annotated, Literal
 
@@ -31,7 +31,7 @@ class TaskCamera(Frozen):
     depth: bool = Field(False, description="Also record metric depth along the optical axis (m).")
 
     @model_validator(mode="after")
-    def _sane(self) -> TaskCamera:
+    def _sane(self) -> "TaskCamera":
         if self.width % 2 or self.height % 2:
             raise ValueError(f"width and height must be even (video encoding), got {self.width}x{self.height}")
         if self.position == self.look_at:

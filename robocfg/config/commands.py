@@ -1,6 +1,6 @@
 """Parameter blocks of the ``run`` commands (one model per command). Units: m, rad, s, N."""
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import Annotated, Literal
 
@@ -88,7 +88,7 @@ class Motion(Frozen):
     loop: bool = Field(False, description="waypoints: start over after the last one.")
 
     @model_validator(mode="after")
-    def _waypoints(self) -> Motion:
+    def _waypoints(self) -> "Motion":
         if self.type == "waypoints" and not self.waypoints:
             raise ValueError("motion type 'waypoints' needs a non-empty 'waypoints' list")
         if self.waypoint_times:
@@ -114,7 +114,7 @@ class FollowObstacle(Pose):
     motion: Motion | None = None
 
     @model_validator(mode="after")
-    def _size_for_shape(self) -> FollowObstacle:
+    def _size_for_shape(self) -> "FollowObstacle":
         need = {"box": 3, "sphere": 1, "capsule": 2}[self.shape]
         if len(self.size) != need:
             raise ValueError(f"'size' needs {need} value(s) for shape '{self.shape}', got {len(self.size)}")
@@ -160,7 +160,7 @@ class FollowTargetParams(Frozen):
     placement: Literal["world", "auto"] = Field("world", description="world: the motion's points, its radius and the obstacles are world coordinates (m), used as written. auto: world coordinates written for the robot the file names; a robot that cannot reach them (--robot) gets them moved with its arm: scaled about its arm base by the ratio of the two arms' reaches towards the points (see docs/task-yaml.md).")
 
     @model_validator(mode="after")
-    def _unique_obstacles(self) -> FollowTargetParams:
+    def _unique_obstacles(self) -> "FollowTargetParams":
         names = [o.name for o in self.obstacles]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
@@ -221,7 +221,7 @@ class PickPlaceParams(Frozen):
     max_tilt_deg: PositiveFloat = 15.0
 
     @model_validator(mode="after")
-    def _object_rests(self) -> PickPlaceParams:
+    def _object_rests(self) -> "PickPlaceParams":
         if self.object.mass <= 0:
             raise ValueError("object.mass must be > 0 for pick-place (a static object cannot be picked)")
         return self
@@ -248,7 +248,7 @@ class Workspace(Frozen):
     max: Vec3 = Field(default_factory=lambda: [0.8, 0.35, 0.35])
 
     @model_validator(mode="after")
-    def _ordered(self) -> Workspace:
+    def _ordered(self) -> "Workspace":
         if any(lo >= hi for lo, hi in zip(self.min, self.max, strict=True)):
             raise ValueError(f"workspace min {self.min} must be below max {self.max} on every axis")
         return self

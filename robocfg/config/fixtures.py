@@ -8,7 +8,7 @@ fixture's own frame (m). Each part is a :class:`Body` named ``FIXTURE/PART`` (``
 so contacts and failures name the part.
 """
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import TYPE_CHECKING, Annotated, Literal
 
@@ -35,7 +35,7 @@ class _FixtureBase(Pose):
             raise ValueError("'size' must be positive in every direction")
         return self
 
-    def _box(self, part: str, size: list[float], centre: list[float]) -> Body:
+    def _box(self, part: str, size: list[float], centre: list[float]) -> "Body":
         """A part: ``centre`` in the fixture frame (origin at the footprint centre)."""
         from robocfg.config.scene import (
             Body,  # scene.py lists the fixtures: imported here, not at the top
@@ -63,7 +63,7 @@ class BinFixture(_FixtureBase):
             raise ValueError(f"'wall' {self.wall:g} m leaves no room inside a {x:g} × {y:g} × {z:g} m bin")
         return self
 
-    def parts(self) -> list[Body]:
+    def parts(self) -> "list[Body]":
         x, y, z, w = *self.size, self.wall
         return [
             self._box("floor", [x, y, w], [0, 0, w / 2]),
@@ -96,7 +96,7 @@ class ShelfFixture(_FixtureBase):
             raise ValueError("'levels' must be given from the bottom up")
         return self
 
-    def parts(self) -> list[Body]:
+    def parts(self) -> "list[Body]":
         x, y, z, b = *self.size, self.board
         out = [
             self._box("back", [b, y, z], [(x - b) / 2, 0, z / 2]),
@@ -119,7 +119,7 @@ class BlockFixture(_FixtureBase):
 
     type: Literal["block"] = Field(description="Selects the fixture kind.")
 
-    def parts(self) -> list[Body]:
+    def parts(self) -> "list[Body]":
         return [self._box("block", list(self.size), [0, 0, self.size[2] / 2])]
 
 

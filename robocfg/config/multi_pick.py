@@ -4,7 +4,7 @@ region, picked in turn (out of clutter or a bin) and placed into a bin or onto a
 Units: m, deg where the key says so, s. Positions are world coordinates.
 """
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import Annotated, Literal
 
@@ -55,7 +55,7 @@ class PickPlaceManyParams(Frozen):
     max_tilt_deg: PositiveFloat = Field(15.0, description="Largest tilt (deg) of a placed object from how it lay.")
 
     @model_validator(mode="after")
-    def _objects(self) -> PickPlaceManyParams:
+    def _objects(self) -> "PickPlaceManyParams":
         names = [o.name for o in self.objects]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:

@@ -6,7 +6,7 @@ position among the URDF's movable joints, as ``robocfg inspect`` prints them); t
 (x approach, y closing, z = x × y) to the EE frame: ``world_R_ee = world_R_grasp · R_ee_graspnet``.
 """
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import Annotated, Literal
 
@@ -59,7 +59,7 @@ class ParallelGripperConfig(Frozen):
     )
 
     @model_validator(mode="after")
-    def _shape(self) -> ParallelGripperConfig:
+    def _shape(self) -> "ParallelGripperConfig":
         if self.joints is None and self.gripper_indices is None:
             raise ValueError("give the driven joints by name ('joints') and/or 'gripper_indices'")
         n = len(self.joints) if self.joints is not None else len(self.gripper_indices or [])
@@ -138,7 +138,7 @@ class ArmConfig(Frozen):
     collision_filter: CollisionFilter = Field(default_factory=CollisionFilter, description="Link lists for contact handling.")
 
     @model_validator(mode="after")
-    def _shape(self) -> ArmConfig:
+    def _shape(self) -> "ArmConfig":
         if self.joints is None and self.joint_indices is None:
             raise ValueError("give the arm joints by name ('joints') and/or 'joint_indices'")
         n = len(self.joints) if self.joints is not None else len(self.joint_indices or [])
@@ -239,7 +239,7 @@ class RobotConfig(Frozen):
         return v
 
     @model_validator(mode="after")
-    def _unique_arms(self) -> RobotConfig:
+    def _unique_arms(self) -> "RobotConfig":
         names = [a.name for a in self.arms]
         if len(set(names)) != len(names):
             raise ValueError(f"arm names must be unique, got {names}")

@@ -1,6 +1,6 @@
 """Scene models for task YAMLs: ground, table, pedestal, objects, obstacles. Sizes in metres, mass in kg."""
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import Annotated, Literal
 
@@ -25,7 +25,7 @@ class Body(Pose):
     color: Color = Field(default_factory=lambda: [0.8, 0.3, 0.2, 1.0], description="RGBA, 0..1.")
 
     @model_validator(mode="after")
-    def _size_for_shape(self) -> Body:
+    def _size_for_shape(self) -> "Body":
         need = {"box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": 3}[self.shape]
         if len(self.size) != need:
             raise ValueError(f"'size' needs {need} value(s) for shape '{self.shape}', got {len(self.size)}")

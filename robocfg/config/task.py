@@ -1,6 +1,6 @@
 """Task YAML schema: ``task:`` selects the command; the command's block holds its parameters."""
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 from typing import TYPE_CHECKING, Annotated, Literal, cast
 
@@ -30,7 +30,7 @@ class RobotMount(Pose):
     ignore_substring: list[str] = Field(default_factory=new_list, description="Bodies whose name contains one of these do not collide with the robot.")
 
     @model_validator(mode="after")
-    def _one_source(self) -> RobotMount:
+    def _one_source(self) -> "RobotMount":
         if (self.robot is None) == (self.robot_config_file is None):
             raise ValueError("give exactly one of 'robot' (a name) or 'robot_config_file' (a path)")
         return self
@@ -132,14 +132,14 @@ def add_task_kind(kind: str, params: type[Frozen], description: str = "") -> typ
     return model
 
 
-def remove_task_kind(kind: str) -> None:
+def remove_task_kind(kind: str) -> "None":
     """Forget a kind declared with :func:`add_task_kind` (the built-in ones stay)."""
     if kind in _BUILTIN_KINDS:
         raise ValueError(f"task kind {kind!r} is built in")
     TASK_MODELS.pop(kind, None)
 
 
-def task_union() -> TypeForm[TaskBase]:
+def task_union() -> "TypeForm[TaskBase]":
     """The discriminated union of every declared task kind (what a task YAML validates against)."""
     from functools import reduce
     from operator import or_

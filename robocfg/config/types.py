@@ -1,6 +1,6 @@
 """Shared field types: vectors, rotations, poses. Units are SI; angles in degrees only in ``*_deg`` keys."""
 
-from __future__ import annotations
+# Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
 import math
 from typing import Annotated, Literal
@@ -73,7 +73,7 @@ class Pose(Frozen):
         return data
 
     @model_validator(mode="after")
-    def _one_orientation(self) -> Pose:
+    def _one_orientation(self) -> "Pose":
         given = [k for k in ("euler_deg", "quat_xyzw", "quat_wxyz") if getattr(self, k) is not None]
         if len(given) > 1:
             raise ValueError(f"give one orientation, not {' and '.join(given)}")
