@@ -232,8 +232,8 @@ class SceneQueries:
         """Whether a contact point of the last step between links ``links_a`` of ``a`` and body
         ``b`` is at distance ≤ 0 (touching or penetrating)."""
         ia, ib = self.body_id(a), self.body_id(b)
-        return any(c[8] <= 0.0 for link in links_a
-                   for c in p.getContactPoints(ia, ib, link, physicsClientId=self.client))
+        links = set(links_a)  # one query of a's contacts with b (PyBullet puts the asked body A first), by link
+        return any(c[8] <= 0.0 and c[3] in links for c in p.getContactPoints(ia, ib, physicsClientId=self.client))
 
     def aabb(self, body: str | int, link: int = -1) -> tuple[np.ndarray, np.ndarray]:
         """(min corner, max corner) of a body's (or link's) axis-aligned bounding box (world, m)."""
