@@ -88,6 +88,9 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     assert "scipy.linalg" not in names and "scipy.linalg._flapack" in names  # LAPACK without scipy.linalg
     assert "scipy" not in names  # nor scipy's __init__ (its version checks)
     assert [m for m in OTHER_KINDS if m in names] == []  # the registry loaded this kind's runner only
+    other_models = [f"robocfg.config.{m}" for m in ("gripper_task", "trajectory_task", "follow_target_task",
+                                                      "grasp_task", "multi_pick")]
+    assert [m for m in other_models if m in names] == []  # nor the other kinds' config models
     ik = {"robocfg.kinematics.ik.lm", "robocfg.kinematics.ik.pink_qp", "robocfg.kinematics.ik.placo_qp"}
     assert ik & names == {"robocfg.kinematics.ik.lm"}  # the IK backend it solves with, not the QP ones
 

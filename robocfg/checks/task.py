@@ -6,7 +6,7 @@ import copy
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from pydantic import TypeAdapter, ValidationError
@@ -25,17 +25,13 @@ from robocfg.config.overrides import (
     parse_key,
 )
 from robocfg.config.scene import Body
-from robocfg.config.task import (
-    TASK_MODELS,
-    PickPlaceManyTask,
-    PickPlaceTask,
-    TaskBase,
-    TaskConfig,
-    task_union,
-)
+from robocfg.config.task import TASK_MODELS, PickPlaceTask, TaskBase, task_union
 from robocfg.config.validation import validate_document
 from robocfg.errors import ConfigError, NotFound, Problem
 from robocfg.suggest import did_you_mean
+
+if TYPE_CHECKING:  # made when a task of their kind is validated (robocfg.config.task)
+    from robocfg.config.task import TaskConfig
 
 _TASK_ADAPTER: tuple[tuple[str, ...], TypeAdapter[TaskBase]] | None = None
 
@@ -222,12 +218,12 @@ def _check_document(doc: YamlDocument, strict: bool, robot_override: str | None)
     warnings: list[Problem] = []
     obj = config.pick_place.object if isinstance(config, PickPlaceTask) else None
     extra: list[tuple[tuple, Body]] = [] if obj is None else [(("pick_place", "object"), obj)]
-    if isinstance(config, PickPlaceManyTask):
+    if config.task == "pick_place_many":
         extra = [(("pick_place_many", "objects", k), o) for k, o in enumerate(config.pick_place_many.objects)]
     problems += check_scene(doc, config.scene, extra)
     if not problems:
         problems += check_task_params(doc, config, robots[0])
-    if not problems and isinstance(config, PickPlaceManyTask):
+    if not problems and config.task == "pick_place_many":
         from robocfg.checks.clutter import check_many
 
         problems += check_many(doc, config.scene, config.pick_place_many)

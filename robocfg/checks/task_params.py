@@ -9,6 +9,7 @@ through :func:`robocfg.checks.task.load_task`, so they stop a run before it simu
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,17 +20,17 @@ from robocfg.checks.waypoints import PositionLimits, check_joint_waypoints
 from robocfg.config.load import Loc, YamlDocument
 from robocfg.config.robot import ParallelGripperConfig, SuctionGripperConfig
 from robocfg.config.scene import Body
-from robocfg.config.task import (
-    FollowTargetTask,
-    GraspTask,
-    GripperTask,
-    PickPlaceManyTask,
-    PickPlaceTask,
-    TaskConfig,
-    TrajectoryTask,
-)
+from robocfg.config.task import PickPlaceTask
 from robocfg.errors import Problem
 from robocfg.suggest import did_you_mean
+
+if TYPE_CHECKING:  # made when a task of their kind is validated (robocfg.config.task): told apart by kind
+    from robocfg.config.task import (
+        GraspTask,
+        GripperTask,
+        TaskConfig,
+        TrajectoryTask,
+    )
 
 
 def check_task_params(doc: YamlDocument, task: TaskConfig, robot: CheckedRobot) -> list[Problem]:
@@ -37,20 +38,20 @@ def check_task_params(doc: YamlDocument, task: TaskConfig, robot: CheckedRobot) 
     problems = _check_meshes(doc, task)
     problems += _unique_names(doc, [(("scene", key, k), b.name) for key in ("objects", "obstacles")
                                     for k, b in enumerate(getattr(task.scene, key))], taken=set())
-    if isinstance(task, GripperTask):
+    if task.task == "gripper":
         problems += _check_gripper(doc, task, robot)
-    elif isinstance(task, TrajectoryTask):
+    elif task.task == "trajectory":
         problems += _check_trajectory(doc, task, robot)
-    elif isinstance(task, GraspTask):
+    elif task.task == "grasp":
         problems += _check_grasp(doc, task, robot)
     elif isinstance(task, PickPlaceTask):
         problems += _unique_against_scene(doc, task, [(("pick_place", "object"), task.pick_place.object.name)])
         problems += _timed_arm(robot, None)
-    elif isinstance(task, PickPlaceManyTask):
+    elif task.task == "pick_place_many":
         objects = task.pick_place_many.objects
         problems += _unique_against_scene(doc, task, [(("pick_place_many", "objects", k), o.name) for k, o in enumerate(objects)])
         problems += _timed_arm(robot, None)
-    elif isinstance(task, FollowTargetTask):
+    elif task.task == "follow_target":
         obstacles = task.follow_target.obstacles
         problems += _unique_against_scene(doc, task, [(("follow_target", "obstacles", k), o.name) for k, o in enumerate(obstacles)])
     return problems
@@ -63,10 +64,10 @@ def _bodies(task: TaskConfig) -> Iterator[tuple[Loc, Body]]:
             yield ("scene", key, k), b
     if isinstance(task, PickPlaceTask):
         yield ("pick_place", "object"), task.pick_place.object
-    if isinstance(task, GraspTask):
+    if task.task == "grasp":
         for k, b in enumerate(task.grasp.objects):
             yield ("grasp", "objects", k), b
-    if isinstance(task, PickPlaceManyTask):
+    if task.task == "pick_place_many":
         for k, b in enumerate(task.pick_place_many.objects):
             yield ("pick_place_many", "objects", k), b
 

@@ -1,5 +1,7 @@
-"""Parameter block of ``run pick-place-many``: several objects, each with its own randomisation
-region, picked in turn (out of clutter or a bin) and placed into a bin or onto a shelf level.
+"""Parameter block of ``run pick-place-many`` and its task model: several objects, each with its own
+randomisation region, picked in turn (out of clutter or a bin) and placed into a bin or onto a
+shelf level. Made when a task of this kind is first validated (``robocfg.config.task.TASK_MODELS``),
+not in every process.
 
 Units: m, deg where the key says so, s. Positions are world coordinates.
 """
@@ -12,6 +14,7 @@ from pydantic import Field, model_validator
 
 from robocfg.config.commands import PhaseTimeouts, Region
 from robocfg.config.scene import Body
+from robocfg.config.task_base import TaskBase
 from robocfg.config.types import FiniteFloat, Frozen, NonNegFloat, PositiveFloat
 
 
@@ -63,3 +66,8 @@ class PickPlaceManyParams(Frozen):
         if any(o.mass <= 0 for o in self.objects):
             raise ValueError("every object's mass must be > 0 (a static object cannot be picked)")
         return self
+
+
+class PickPlaceManyTask(TaskBase):
+    task: Literal["pick_place_many"] = Field(description="The command this file configures; selects the parameter block.")
+    pick_place_many: PickPlaceManyParams = Field(description="Parameters of `robocfg run pick-place-many`.")

@@ -1,99 +1,109 @@
-"""Task YAML schema: ``task:`` selects the command; the command's block holds its parameters."""
+"""Task YAML schema: ``task:`` selects the command; the command's block holds its parameters.
+
+Each kind's task model is :class:`~robocfg.config.task_base.TaskBase` with ``task: <kind>`` and the
+kind's parameter block. ``pick_place``'s is made here; the other built-in kinds' are made in their
+own modules (``gripper_task``, ``trajectory_task``, ``follow_target_task``, ``grasp_task``,
+``multi_pick``) when :data:`TASK_MODELS` is first asked for them, so a process that validates and
+runs one kind does not make every other kind's models (≈ 20 pydantic model classes). Their names
+stay importable from here (``from robocfg.config.task import GripperTask``: made on that import).
+"""
 
 # Annotations are evaluated as each class is made (no postponed annotations: robocfg.config's docstring).
 
+import importlib
+from collections.abc import Iterator, MutableMapping
 from typing import TYPE_CHECKING, Annotated, Literal, cast
 
-from pydantic import Field, JsonValue, model_validator
+from pydantic import Field
 
-from robocfg.config.cameras import TaskCamera
-from robocfg.config.commands import (
-    FollowTargetParams,
-    GraspParams,
-    GripperParams,
-    PickPlaceParams,
-    TrajectoryParams,
+from robocfg.config.commands import PickPlaceParams
+from robocfg.config.task_base import (
+    RobotMount as RobotMount,  # re-exported: the world imports it from here
 )
-from robocfg.config.multi_pick import PickPlaceManyParams
-from robocfg.config.scene import Scene, Sim
-from robocfg.config.types import Frozen, Pose, SchemaVersion, new_list
+from robocfg.config.task_base import TaskBase
+from robocfg.config.types import Frozen
 
 if TYPE_CHECKING:
     from typing_extensions import TypeForm  # PEP 747; typing has it from Python 3.14
 
-
-class RobotMount(Pose):
-    """Which robot, and where its base stands (world frame)."""
-
-    robot: str | None = Field(None, description="Robot name on the search path (e.g. 'panda').")
-    robot_config_file: str | None = Field(None, description="Path to a robot YAML, relative to this task file.")
-    ignore_substring: list[str] = Field(default_factory=new_list, description="Bodies whose name contains one of these do not collide with the robot.")
-
-    @model_validator(mode="after")
-    def _one_source(self) -> "RobotMount":
-        if (self.robot is None) == (self.robot_config_file is None):
-            raise ValueError("give exactly one of 'robot' (a name) or 'robot_config_file' (a path)")
-        return self
-
-
-class TaskBase(Frozen):
-    """Fields every task YAML has, whatever its kind."""
-
-    schema_version: SchemaVersion = Field(description="File format version; this is 1.")
-    description: str = Field("", description="Free text.")
-    robots: list[RobotMount] = Field(min_length=1, description="Robots in the scene; the first one runs the command.")
-    scene: Scene = Field(default_factory=Scene, description="Everything in the world besides the robots.")
-    sim: Sim = Field(default_factory=Sim, description="Simulation settings.")
-    cameras: list[TaskCamera] = Field(default_factory=new_list, description="Cameras recorded into datasets (--dataset); none: state only.")
-    variants: dict[str, dict[str, JsonValue]] = Field(
-        default_factory=dict,
-        description="Per-robot changes: robot name → {dotted key: value} (as `--set`), applied when that robot "
-                    "runs the task (first in `robots`, or chosen with `--robot`). For cells whose robots differ in "
-                    "reach: each robot gets fixtures and pick/place points it can reach.",
-    )
-
-
-class GripperTask(TaskBase):
-    task: Literal["gripper"] = Field(description="The command this file configures; selects the parameter block.")
-    gripper: GripperParams = Field(default_factory=GripperParams, description="Parameters of `robocfg run gripper`.")
-
-
-class TrajectoryTask(TaskBase):
-    task: Literal["trajectory"] = Field(description="The command this file configures; selects the parameter block.")
-    trajectory: TrajectoryParams = Field(default_factory=TrajectoryParams, description="Parameters of `robocfg run trajectory`.")
-
-
-class FollowTargetTask(TaskBase):
-    task: Literal["follow_target"] = Field(description="The command this file configures; selects the parameter block.")
-    follow_target: FollowTargetParams = Field(default_factory=FollowTargetParams, description="Parameters of `robocfg run follow-target`.")
-
+    from robocfg.config.follow_target_task import FollowTargetTask
+    from robocfg.config.grasp_task import GraspTask
+    from robocfg.config.gripper_task import GripperTask
+    from robocfg.config.multi_pick import PickPlaceManyTask
+    from robocfg.config.trajectory_task import TrajectoryTask
 
 class PickPlaceTask(TaskBase):
     task: Literal["pick_place"] = Field(description="The command this file configures; selects the parameter block.")
     pick_place: PickPlaceParams = Field(description="Parameters of `robocfg run pick-place`.")
 
 
-class PickPlaceManyTask(TaskBase):
-    task: Literal["pick_place_many"] = Field(description="The command this file configures; selects the parameter block.")
-    pick_place_many: PickPlaceManyParams = Field(description="Parameters of `robocfg run pick-place-many`.")
-
-
-class GraspTask(TaskBase):
-    task: Literal["grasp"] = Field(description="The command this file configures; selects the parameter block.")
-    grasp: GraspParams = Field(default_factory=GraspParams, description="Parameters of `robocfg run grasp`.")
-
-
-TaskConfig = Annotated[
-    GripperTask | TrajectoryTask | FollowTargetTask | PickPlaceTask | GraspTask | PickPlaceManyTask,
-    Field(discriminator="task"),
-]
-"""The built-in task kinds as a static type (what type checkers see); the validator itself is
-built from ``TASK_MODELS`` by :func:`task_union`, so a kind registered later validates too."""
-
-TASK_MODELS: dict[str, type[TaskBase]] = {
-    "gripper": GripperTask, "trajectory": TrajectoryTask, "follow_target": FollowTargetTask,
-    "pick_place": PickPlaceTask, "grasp": GraspTask, "pick_place_many": PickPlaceManyTask,
+# the built-in kinds in their order, each with the module and name of its task model
+_BUILTIN: dict[str, tuple[str, str]] = {
+    "gripper": ("robocfg.config.gripper_task", "GripperTask"),
+    "trajectory": ("robocfg.config.trajectory_task", "TrajectoryTask"),
+    "follow_target": ("robocfg.config.follow_target_task", "FollowTargetTask"),
+    "pick_place": (__name__, "PickPlaceTask"),
+    "grasp": ("robocfg.config.grasp_task", "GraspTask"),
+    "pick_place_many": ("robocfg.config.multi_pick", "PickPlaceManyTask"),
 }
+_LAZY_NAMES = {name: module for module, name in _BUILTIN.values() if module != __name__}
+
+if TYPE_CHECKING:
+    TaskConfig = Annotated[
+        GripperTask | TrajectoryTask | FollowTargetTask | PickPlaceTask | GraspTask | PickPlaceManyTask,
+        Field(discriminator="task"),
+    ]
+    """The built-in task kinds as a static type (what type checkers see); the validator itself is
+    built from ``TASK_MODELS`` by :func:`task_union`, so a kind registered later validates too.
+    At run time the same ``Annotated`` union, made on first use (module ``__getattr__``)."""
+
+
+def __getattr__(name: str) -> object:
+    """The other built-in kinds' task models and ``TaskConfig``, made on first use."""
+    if name in _LAZY_NAMES:
+        return getattr(importlib.import_module(_LAZY_NAMES[name]), name)
+    if name == "TaskConfig":
+        members = tuple(TASK_MODELS[kind] for kind in _BUILTIN)
+        config = Annotated[members[0] | members[1] | members[2] | members[3] | members[4] | members[5],  # type: ignore[valid-type]
+                           Field(discriminator="task")]
+        globals()["TaskConfig"] = config
+        return config
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+class _TaskModels(MutableMapping[str, type[TaskBase]]):
+    """Task kind → its task model, in declaration order; a built-in kind's model module is imported
+    when the kind's model is first asked for (``[kind]``, ``get``, ``values``, ``items``), not when
+    only its name is (``in``, iteration, ``len``)."""
+
+    def __init__(self) -> None:
+        self._models: dict[str, type[TaskBase] | None] = dict.fromkeys(_BUILTIN)
+        self._models["pick_place"] = PickPlaceTask
+
+    def __getitem__(self, kind: str) -> type[TaskBase]:
+        model = self._models[kind]
+        if model is None:
+            module, name = _BUILTIN[kind]
+            model = self._models[kind] = getattr(importlib.import_module(module), name)
+        return model
+
+    def __contains__(self, kind: object) -> bool:
+        return kind in self._models
+
+    def __setitem__(self, kind: str, model: type[TaskBase]) -> None:
+        self._models[kind] = model
+
+    def __delitem__(self, kind: str) -> None:
+        del self._models[kind]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._models)
+
+    def __len__(self) -> int:
+        return len(self._models)
+
+
+TASK_MODELS: MutableMapping[str, type[TaskBase]] = _TaskModels()
 """Task kind (the YAML's ``task:`` value) → its task model. The runner registry
 (``robocfg.engine.registry``) pairs each kind with its runner; a test checks the two agree.
 Every model holds the kind's parameters under a key named like the kind."""
