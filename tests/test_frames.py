@@ -91,3 +91,63 @@ def test_half_turn_turns_about_the_tool_axis(panda_arm):
     H = half_turn(R, panda_arm)
     assert np.allclose(H[:, 2], R[:, 2]) and np.allclose(H[:, :2], -R[:, :2])
     assert np.isclose(np.linalg.det(H), 1.0)
+
+
+def _ee_pose_from_grasp_arrays(grasp, arm, standoff=0.0):
+    """ee_pose_from_grasp as numpy arrays compute it (the code before its Python-float rewrite)."""
+    from robocfg.kinematics import frames
+
+    R_ee = grasp.rotation @ np.asarray(arm.R_ee_graspnet, float)
+    tcp = np.asarray(grasp.center, float) - standoff * grasp.approach()
+    tcp = tcp - frames.grasp_side_shift(arm, grasp.width) * grasp.closing()
+    T = np.eye(4)
+    T[:3, :3] = R_ee
+    T[:3, 3] = tcp - arm.tcp_offset * R_ee[:, AXIS_INDEX[arm.ee_axis]]
+    return T
+
+
+def test_grasp_rotation_in_floats_has_the_arrays_bits():
+    """The Python-float path gives numpy's bits: random directions over six decades, lists of ints,
+    near-parallel pairs; a zero approach and other shapes take the arrays' own path."""
+    from robocfg.kinematics.frames import _grasp_rotation_arrays
+
+    rng = np.random.default_rng(7)
+    for i in range(20000):
+        a = rng.normal(size=3) * 10.0 ** rng.integers(-3, 3)
+        c = rng.normal(size=3) * 10.0 ** rng.integers(-3, 3)
+        if i % 5 == 0:
+            c = a * rng.normal() + rng.normal(size=3) * 1e-6  # nearly parallel: the orthogonalisation matters
+        if i % 7 == 0:
+            a, c = np.round(a), np.round(c)  # axis-like directions
+        try:
+            want = _grasp_rotation_arrays(a, c)
+        except ValueError:
+            with pytest.raises(ValueError, match="parallel"):
+                grasp_rotation(a, c)
+            continue
+        assert grasp_rotation(a, c).tobytes() == want.tobytes()
+        assert grasp_rotation(list(a), tuple(c)).tobytes() == want.tobytes()
+    assert grasp_rotation([0, 0, -1], [1, 2, 0]).tobytes() == _grasp_rotation_arrays([0, 0, -1], [1, 2, 0]).tobytes()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        assert np.isnan(grasp_rotation([0.0, 0.0, 0.0], [1.0, 0.0, 0.0])).all()  # as numpy: NaN, not an error
+    with pytest.raises(ValueError, match="parallel"):
+        grasp_rotation([0, 0, 1], [0, 0, 2])
+
+
+@pytest.mark.parametrize("axis", ["x", "y", "z"])
+def test_ee_pose_from_grasp_in_floats_has_the_arrays_bits(panda_arm, monkeypatch, axis):
+    """The EE pose's Python-float part (after numpy's R_ee product) gives the arrays' bits: random
+    grasps, stand-offs and side shifts (a one-jaw gripper's), every ee_axis."""
+    from robocfg.kinematics import frames
+
+    rng = np.random.default_rng(3)
+    arm = panda_arm.model_copy(update={"ee_axis": axis, "tcp_offset": float(rng.uniform(0.05, 0.2))})
+    shifts = iter(rng.normal(size=4000) * 0.02)
+    shift = [0.0]
+    monkeypatch.setattr(frames, "grasp_side_shift", lambda arm, width: shift[0])
+    for i in range(2000):
+        shift[0] = 0.0 if i % 3 == 0 else float(next(shifts))
+        R = grasp_rotation(rng.normal(size=3), rng.normal(size=3))
+        g = Grasp(rng.normal(size=3) * 10.0 ** rng.integers(-2, 1), R, 0.04)
+        standoff = 0.0 if i % 4 == 0 else float(rng.uniform(0.0, 0.3))
+        assert ee_pose_from_grasp(g, arm, standoff).tobytes() == _ee_pose_from_grasp_arrays(g, arm, standoff).tobytes()

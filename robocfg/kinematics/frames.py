@@ -15,6 +15,7 @@ or a Unitree Z1 whose approach axis is its ee_link's x.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,7 +40,30 @@ class Grasp:
 
 
 def grasp_rotation(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
-    """world_R_grasp from an approach and a closing direction (closing is orthogonalised)."""
+    """world_R_grasp from an approach and a closing direction (closing is orthogonalised).
+
+    Two 3-vectors are done in Python floats with numpy's bits: each quotient, product and
+    difference the one the elementwise arrays make, and numpy's 3-term dot products and norms
+    sum their products left to right from 0.0 (tests/test_frames.py compares them on random
+    vectors); a zero approach (numpy: NaN, not an error) and other shapes go the arrays' way."""
+    a, c = np.asarray(approach, float), np.asarray(closing, float)
+    if a.shape == (3,) and c.shape == (3,):
+        (a0, a1, a2), (c0, c1, c2) = a.tolist(), c.tolist()
+        na = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+        if na != 0.0:
+            x0, x1, x2 = a0 / na, a1 / na, a2 / na
+            d = 0.0 + c0 * x0 + c1 * x1 + c2 * x2  # from 0.0, as numpy's dot: -0.0 products sum to +0.0
+            y0, y1, y2 = c0 - d * x0, c1 - d * x1, c2 - d * x2
+            n = math.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            if n < 1e-9:
+                raise ValueError("closing direction is parallel to the approach direction")
+            y0, y1, y2 = y0 / n, y1 / n, y2 / n
+            return np.array([[x0, y0, x1 * y2 - x2 * y1], [x1, y1, x2 * y0 - x0 * y2], [x2, y2, x0 * y1 - x1 * y0]])
+    return _grasp_rotation_arrays(approach, closing)
+
+
+def _grasp_rotation_arrays(approach: np.ndarray, closing: np.ndarray) -> np.ndarray:
+    """:func:`grasp_rotation` with numpy arrays (any shape numpy takes; a zero approach gives NaN)."""
     x = np.asarray(approach, float) / np.linalg.norm(approach)
     y = np.asarray(closing, float) - np.dot(closing, x) * x
     n = np.linalg.norm(y)
@@ -93,13 +117,26 @@ def ee_pose_from_grasp(grasp: Grasp, arm: ArmConfig, standoff: float = 0.0) -> n
     approach by ``standoff`` metres), with ``world_R_ee = world_R_grasp · R_ee_graspnet``.
     For a one-jaw gripper the EE is also moved across by :func:`grasp_side_shift` at the grasp's
     width, so the fixed jaw's face lands on the object's side instead of inside it."""
-    R_ee = grasp.rotation @ np.asarray(arm.R_ee_graspnet, float)
-    tcp = np.asarray(grasp.center, float) - standoff * grasp.approach()
-    tcp = tcp - grasp_side_shift(arm, grasp.width) * grasp.closing()
-    T = np.eye(4)
-    T[:3, :3] = R_ee
-    T[:3, 3] = tcp - arm.tcp_offset * R_ee[:, AXIS_INDEX[arm.ee_axis]]
-    return T
+    R_ee = grasp.rotation @ np.asarray(arm.R_ee_graspnet, float)  # numpy's product (its BLAS may fuse)
+    center = np.asarray(grasp.center, float)
+    if center.shape != (3,) or R_ee.shape != (3, 3):
+        tcp = center - standoff * grasp.approach()
+        tcp = tcp - grasp_side_shift(arm, grasp.width) * grasp.closing()
+        T = np.eye(4)
+        T[:3, :3] = R_ee
+        T[:3, 3] = tcp - arm.tcp_offset * R_ee[:, AXIS_INDEX[arm.ee_axis]]
+        return T
+    # the rest in Python floats: each product and difference the one the arrays above make
+    (g00, g01, _), (g10, g11, _), (g20, g21, _) = np.asarray(grasp.rotation, float).tolist()
+    shift, off, k = grasp_side_shift(arm, grasp.width), arm.tcp_offset, AXIS_INDEX[arm.ee_axis]
+    rows = R_ee.tolist()
+    out = []
+    for c, a, b, r in zip(center.tolist(), (g00, g10, g20), (g01, g11, g21), rows, strict=True):
+        t = c - standoff * a
+        t = t - shift * b
+        out.append([*r, t - off * r[k]])
+    out.append([0.0, 0.0, 0.0, 1.0])
+    return np.array(out)
 
 
 def tcp_from_ee(T_ee: np.ndarray, arm: ArmConfig) -> np.ndarray:
