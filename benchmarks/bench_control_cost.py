@@ -98,7 +98,6 @@ BUCKETS = (  # (module, class or None for a module function, function, label); e
     ("robocfg.sim.robot", "RobotHandle", "link_position_quat", "state reads"),
     ("robocfg.sim.robot", "RobotHandle", "joint_positions", "state reads"),
     ("robocfg.sim.world", "World", "body_pose", "state reads"),
-    ("robocfg.runners.pick_place_machine", "_StateMachine", "_object_pose", "state reads"),
     ("robocfg.runners.pick_place_machine", "_StateMachine", "result", "episode record"),
 )
 

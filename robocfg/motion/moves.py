@@ -29,7 +29,6 @@ from robocfg.errors import PhaseFailed
 from robocfg.motion.joint_travel import joint_travel
 from robocfg.motion.minjerk_path import JointSpline, MinJerkPath
 from robocfg.motion.pose_goal import PoseGoal
-from robocfg.sim.same_step import SameStepReads
 
 if TYPE_CHECKING:
     from robocfg.kinematics.ik.result import IKResult
@@ -92,24 +91,6 @@ class ArmMover:
     max_acceleration: float | None = None  # m/s²: the EE's peak acceleration in a timed move (a held load), None: free
     _answers: dict[tuple[bytes, bytes], IKResult] = field(default_factory=dict, init=False, repr=False)  # see ik()
     _lines: dict[bytes, Plan] = field(default_factory=dict, init=False, repr=False)  # see straight_path()
-    # reads of the current physics state, shared by the mover and its runner (see joints())
-    reads: SameStepReads = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        self.reads = SameStepReads(self.world)
-
-    def joints(self) -> np.ndarray:
-        """The arm's joint positions (rad or m) as measured now: one state read per physics state
-        (:class:`~robocfg.sim.same_step.SameStepReads`), a new array each call."""
-        return self.reads.get("joints", self.arm.joint_positions).copy()
-
-    def ee_position_quat(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
-        """The EE's (position m, quaternion x y z w) as measured now (one read per physics state)."""
-        return self.reads.get("ee", self.arm.ee_position_quat)
-
-    def gripper_width(self) -> float | None:
-        """The gripper's measured finger gap (m; None: no fingers) now (one read per physics state)."""
-        return self.reads.get("width", self._gripper().width)
 
     def ik(self, T: np.ndarray, seed: np.ndarray) -> IKResult:
         """IK of the EE pose ``T`` (4x4, world) from ``seed`` (rad or m), remembered for the mover's
@@ -179,7 +160,7 @@ class ArmMover:
         A joint-space move takes, of the direct IK answer and where a straight line would end
         (:meth:`straight_end`), the one with less joint travel (IK may land on a far branch).
         ``check()`` runs at the end and returns a failure reason or None."""
-        q0 = self.joints()
+        q0 = self.arm.joint_positions()
         path = None
         if straight:
             W, spline = self.straight_path(q0, T_goal)
@@ -288,7 +269,6 @@ class ArmMover:
         while True:
             pos, quat = self.arm.ee_position_quat()
             if goal.reached(pos, quat):
-                self.reads.put("ee", (pos, quat))  # the runner may ask again before the next step
                 return
             if self.world.t - t_start > limit:
                 raise self._not_converged(goal, pos, quat, limit)
@@ -317,11 +297,10 @@ class ArmMover:
             last = w
             if self.world.t - t0 > timeout:
                 if g.is_grasping(body):
-                    break
+                    return
                 width = f" (width {w * 1000:.1f} mm)" if w is not None else ""
                 hint = grasp_hint(self.arm, w)
                 raise MoveFailed(self.phase, f"the object is not held{width}" + (f"; {hint}" if hint else ""))
-        self.reads.put("width", last)  # measured at this state (after the last step): the runner asks again
 
     def _gripper(self) -> Gripper:
         if self.arm.gripper is None:

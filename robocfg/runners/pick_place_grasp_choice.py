@@ -62,7 +62,7 @@ class GraspChoice:
             if first is None:
                 first = group
                 R_now = self.arm.ee_pose()[:3, :3]
-                q0 = self.mover.joints()  # the pre-grasp move reads them at this same step
+                q0 = self.arm.joint_positions()
             cands = sorted(group, key=lambda g: rotation_angle(R_now, g.rotation @ R_ee_graspnet))
             reach = _Reach(self, cands, q0)
             cheapest: int | None = None

@@ -85,10 +85,9 @@ class _StateMachine(GraspChoice):
         lying = LyingObject(self.shape, obj_pos, quat_to_matrix(obj_quat), self._support_height(obj_pos[:2]))
         self.support_z = lying.support_z
         T_lift = self._pick(self._choose_grasp(lying))
-        # Carry the object so that *it* lands on the place point: keep its offset from the EE
-        # (both as the lift check and its last convergence poll measured them: no step since).
-        obj_now, quat_now = self._object_pose()
-        ee_now = np.asarray(self.mover.ee_position_quat()[0], dtype=float)
+        # Carry the object so that *it* lands on the place point: keep its offset from the EE.
+        obj_now, quat_now = self.world.body_pose(self.obj)
+        ee_now = self.arm.ee_pose()[:3, 3]
         offset = ee_now - obj_now
         # its lowest point as it now hangs in the hand (it may have turned a little in the grasp)
         below = self.shape.below_origin(quat_to_matrix(quat_now))
@@ -189,7 +188,7 @@ class _StateMachine(GraspChoice):
         """Carry the object no harder than the grip holds it (:mod:`robocfg.checks.grip_force`):
         the timed moves that hold it (lift, transport, lower) keep the EE's acceleration within
         what friction at the gripper's force (the task's ``grip_force``, else ``max_force``) carries."""
-        width = self.mover.gripper_width()  # as the grasp's last poll measured it (no step since)
+        width = self.gripper.width()
         if width is None:
             return
         body = self.setup.body
@@ -257,16 +256,8 @@ class _StateMachine(GraspChoice):
     def _object_to_tcp(self) -> float:
         return float(np.linalg.norm(self.world.body_pose(self.obj)[0] - self.arm.tcp_pose()[:3, 3]))
 
-    def _object_pose(self) -> tuple[np.ndarray, np.ndarray]:
-        """The object's (position (3,), quat_xyzw (4,)) now, as :meth:`World.body_pose` reads it;
-        read once per physics state (the mover's :class:`~robocfg.sim.same_step.SameStepReads`:
-        the lift check and the carry, the placed check and the record ask at the same step)."""
-        obj = self.obj
-        pos, quat = self.mover.reads.get(("pose", obj), lambda: self.world.body_pose_tuple(obj))
-        return np.asarray(pos), np.asarray(quat)
-
     def _verify_lift(self, z0: float) -> None:
-        z1 = self._object_pose()[0][2]
+        z1 = self.world.body_pose(self.obj)[0][2]
         self.lift_rise = float(z1 - z0)
         want = 0.5 * self.params.lift_height
         if not self._held() or self.lift_rise < want:
@@ -295,7 +286,7 @@ class _StateMachine(GraspChoice):
 
     def _check_placed(self) -> None:
         p = self.params
-        pos, quat = self._object_pose()
+        pos, quat = self.world.body_pose(self.obj)
         err = float(np.linalg.norm(pos[:2] - self.setup.place_xy))
         R = quat_to_matrix(quat)
         tilt = self.shape.tilt_deg(self.R0, R)  # as _tilt(quat)
@@ -317,7 +308,7 @@ class _StateMachine(GraspChoice):
         return self.shape.tilt_deg(self.R0, quat_to_matrix(quat))
 
     def result(self, failed: str | None, reason: str) -> EpisodeResult:
-        pos, quat = self._object_pose()
+        pos, quat = self.world.body_pose(self.obj)
         b, s = self.setup.body, self.setup
         err = float(np.linalg.norm(pos[:2] - s.place_xy))
         return EpisodeResult(

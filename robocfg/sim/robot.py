@@ -20,7 +20,7 @@ view of one arm over the same maps. Splitting it would pass the maps around for 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -54,10 +54,6 @@ class Drive:
     max_velocity: float | None = None
 
 
-def _nothing() -> None:
-    """A robot handle's ``on_teleport`` until a World sets its own."""
-
-
 class RobotHandle:
     """One robot body: name ↔ index maps, state by name, position drives, arms."""
 
@@ -86,7 +82,6 @@ class RobotHandle:
         self._fast: dict[tuple[str, ...], MotorPlan] = {}
         self._drive_tokens: dict[tuple[str, ...], object] = {}
         self.mimic: MimicGears | None = None  # set by the World
-        self.on_teleport: Callable[[], None] = _nothing  # called by reset_joints (the World counts teleports)
         self.arms: dict[str, ArmHandle] = {a.name: ArmHandle(self, a) for a in self.config.arms}
 
     # ---- name lookups -------------------------------------------------------------------
@@ -131,7 +126,6 @@ class RobotHandle:
 
     def reset_joints(self, names: Sequence[str], q: Sequence[float] | np.ndarray, hold: bool = True) -> None:
         """Teleport joints to ``q`` (zero velocity) and, if ``hold``, keep their drives there."""
-        self.on_teleport()
         for n, i, v in zip(names, self.joint_indices(names), np.asarray(q, dtype=float), strict=True):
             p.resetJointState(self.body_id, i, float(v), 0.0, physicsClientId=self.client)
             if hold and n in self.drives:

@@ -27,8 +27,7 @@ buffer per query): in a pick-place episode, ≈ 1.9 % of the physics' instructio
 ``play(arm, q, qd)`` plays a sampled trajectory with one motor call per physics step
 (:mod:`robocfg.sim.playback`).
 
-Length (≈ 430 lines): one concept, the world's build and its step (and the count of its changes
-that :class:`~robocfg.sim.same_step.SameStepReads` keys its reads by); the physics queries already
+Length (≈ 380 lines): one concept, the world's build and its step; the physics queries already
 live in :mod:`robocfg.sim.queries` and the trajectory playback in :mod:`robocfg.sim.playback`.
 """
 
@@ -84,9 +83,6 @@ class World(SceneQueries):
         self.dt: float = cfg.sim.timestep
         self.t: float = 0.0
         self.steps = 0
-        # changes of state without a physics step (see read_stamp): teleports, bodies added or
-        # removed, restores, a robot's reset_joints
-        self.teleports = 0
         # True: every physics step is timed (two perf_counter calls a step, ≈ 1 k instructions,
         # 5-10 % of the loop's own per-step work): ``physics_seconds`` is the wall-clock time spent
         # inside p.stepSimulation, for benchmarks (``RunOptions.time_physics``). False (default):
@@ -185,7 +181,6 @@ class World(SceneQueries):
             flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_EXCLUDE_ALL_PARENTS
         body = load_robot_urdf(c, checked, mount.position, mount.quaternion_xyzw(), flags)
         robot = RobotHandle(c, body, checked)
-        robot.on_teleport = self._teleported
         self.bodies.setdefault(robot.name, body)
         if phys.self_collision:
             filter_gripper_linkage(c, robot)
@@ -245,7 +240,6 @@ class World(SceneQueries):
         if body.name in self.bodies:
             self.remove_body(body.name)
         bid = spawn_body(self.client, body, self.task.path.parent, static=static, cache=self.shape_cache)
-        self.teleports += 1
         self._register(body.name, bid, dynamic=not static and body.mass > 0)
         self._warn_overlap(body.name)
         return bid
@@ -253,7 +247,6 @@ class World(SceneQueries):
     def remove_body(self, name: str) -> None:
         bid = self.body_id(name)
         p.removeBody(bid, physicsClientId=self.client)
-        self.teleports += 1
         del self.bodies[name]
         if bid in self._dynamic:
             self._dynamic.remove(bid)
@@ -285,7 +278,6 @@ class World(SceneQueries):
         bid = self.body_id(name_or_id)
         p.resetBasePositionAndOrientation(bid, list(position), list(quat_xyzw), physicsClientId=self.client)
         p.resetBaseVelocity(bid, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
-        self.teleports += 1
 
     def body_rotation(self, name_or_id: str | int) -> np.ndarray:
         return quat_to_matrix(self.body_pose(name_or_id)[1])
@@ -337,17 +329,6 @@ class World(SceneQueries):
         for hook in self.step_hooks:
             hook()
 
-    @property
-    def read_stamp(self) -> tuple[int, int]:
-        """(physics steps, teleports): equal for two reads only if nothing changed the state in
-        between — no physics step and no change without one (a body's teleport, a body added or
-        removed, a restore, a robot's ``reset_joints``). What :class:`~robocfg.sim.same_step.SameStepReads`
-        keys its values by; changes made through PyBullet directly are not counted."""
-        return self.steps, self.teleports
-
-    def _teleported(self) -> None:
-        self.teleports += 1
-
     def periodic_check(self) -> None:
         """What ``step`` does every ``check_every`` steps: the divergence check
         (``PhysicsDiverged``), then the stop request (``RunInterrupted``)."""
@@ -374,7 +355,6 @@ class World(SceneQueries):
         restored joint positions and every gripper reset open."""
         p.restoreState(stateId=state, physicsClientId=self.client)
         self.t, self.steps = 0.0, 0
-        self.teleports += 1
         self._checked = (-1, [])
         for robot in self.robots:
             for arm in robot.arms.values():
