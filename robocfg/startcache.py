@@ -114,12 +114,17 @@ def _code(text: str) -> CodeType:
 
 def path() -> Path | None:
     """The cache file of this interpreter (bytecode tag, optimisation level, marshal format), or
-    None where the interpreter has no bytecode tag."""
+    None where the interpreter has no bytecode tag or the cache folder has no home directory to
+    be in (:func:`robocfg.cachedir.cache_dir` raises RuntimeError)."""
     tag = sys.implementation.cache_tag
     if tag is None:
         return None
+    try:
+        folder = cache_dir()
+    except RuntimeError:  # no home directory (HOME unset, a uid without a passwd entry): no cache
+        return None
     opt = f".opt-{sys.flags.optimize}" if sys.flags.optimize else ""
-    return cache_dir() / f"dataclasses.{tag}{opt}.m{marshal.version}.bin"
+    return folder / f"dataclasses.{tag}{opt}.m{marshal.version}.bin"
 
 
 def _header(payload: bytes) -> bytes:

@@ -312,6 +312,28 @@ def test_the_switch_turns_it_off(fresh_cache: Path, monkeypatch) -> None:
     assert not startcache.installed() and "exec" not in vars(dataclasses)
 
 
+def test_no_home_directory_means_no_cache_not_an_error(fresh_cache: Path, monkeypatch) -> None:
+    """HOME unset and a uid without a passwd entry (a container run as an arbitrary user):
+    ``Path.home()`` raises RuntimeError; every dataclass the command made failed with it (an
+    "internal error" for every ``robocfg`` command, where the start before the cache worked)."""
+    import pwd
+
+    for name in ("ROBOCFG_CACHE_DIR", "XDG_CACHE_HOME", "HOME"):
+        monkeypatch.delenv(name, raising=False)
+
+    def no_entry(uid: int) -> pwd.struct_passwd:
+        raise KeyError(f"getpwuid(): uid not found: {uid}")
+
+    monkeypatch.setattr(pwd, "getpwuid", no_entry)
+    with pytest.raises(RuntimeError):
+        Path.home()  # what the environment above makes of the default folder
+    startcache.install()
+    assert startcache.path() is None
+    assert _behaviour(_plain_classes(False))  # made, compiled afresh
+    startcache.save()  # nowhere to write: nothing, silently
+    assert not list(fresh_cache.iterdir())
+
+
 def test_only_the_command_installs_it_and_gives_dataclasses_back(fresh_cache: Path, capsys, monkeypatch) -> None:
     from _cli import run_main
 
