@@ -35,6 +35,8 @@ saves, ``restore`` saves and uninstalls) and the process pool's fork server
 untouched.
 """
 
+import __future__
+
 import builtins
 import contextlib
 import dataclasses
@@ -61,13 +63,22 @@ _installed = False
 
 def install() -> None:
     """Let ``dataclasses`` find its generated methods' code in the cache (module docstring).
-    Nothing when ``ROBOCFG_NO_START_CACHE`` is set, when already installed, or when something else
-    shadows ``exec`` in ``dataclasses``."""
+    Nothing when ``ROBOCFG_NO_START_CACHE`` is set, when already installed, when something else
+    shadows ``exec`` in ``dataclasses``, or when ``dataclasses`` imports from ``__future__``."""
     global _installed
-    if _installed or os.environ.get(OFF_VARIABLE) or "exec" in vars(dataclasses):
+    if _installed or os.environ.get(OFF_VARIABLE) or "exec" in vars(dataclasses) or _has_future(dataclasses):
         return
     dataclasses.exec = cached_exec  # type: ignore[attr-defined]
     _installed = True
+
+
+def _has_future(module: object) -> bool:
+    """Whether ``module`` has a ``from __future__ import ...`` (the name is bound to a feature
+    object in its globals). The builtin ``exec`` compiles a source with its caller's future flags;
+    the cache compiles with none (:func:`_code`), so it stays out of a ``dataclasses`` that has
+    any (none has to this day: 3.11 to 3.13)."""
+    feature = type(__future__.annotations)
+    return any(type(value) is feature for value in vars(module).values())
 
 
 def uninstall() -> None:

@@ -312,6 +312,21 @@ def test_the_switch_turns_it_off(fresh_cache: Path, monkeypatch) -> None:
     assert not startcache.installed() and "exec" not in vars(dataclasses)
 
 
+def test_a_dataclasses_with_future_imports_is_left_alone(fresh_cache: Path, monkeypatch) -> None:
+    """The builtin exec compiles with its caller's __future__ flags and the cache with none: a
+    dataclasses module that imported from __future__ would get other code from the cache, so
+    install() stays out of it."""
+    import __future__
+
+    monkeypatch.setattr(dataclasses, "annotations", __future__.annotations, raising=False)
+    startcache.install()
+    assert not startcache.installed() and "exec" not in vars(dataclasses)
+    monkeypatch.delattr(dataclasses, "annotations")
+    startcache.install()
+    assert startcache.installed() and vars(dataclasses)["exec"] is startcache.cached_exec
+    startcache.uninstall()
+
+
 def test_no_home_directory_means_no_cache_not_an_error(fresh_cache: Path, monkeypatch) -> None:
     """HOME unset and a uid without a passwd entry (a container run as an arbitrary user):
     ``Path.home()`` raises RuntimeError; every dataclass the command made failed with it (an
