@@ -142,7 +142,7 @@ def add_task_kind(kind: str, params: type[Frozen], description: str = "") -> typ
     return model
 
 
-def remove_task_kind(kind: str) -> "None":
+def remove_task_kind(kind: str) -> None:
     """Forget a kind declared with :func:`add_task_kind` (the built-in ones stay)."""
     if kind in _BUILTIN_KINDS:
         raise ValueError(f"task kind {kind!r} is built in")
