@@ -46,9 +46,9 @@ def test_no_plugin_installed_robocfg_validates_without_the_entry_point_scan() ->
     assert out.returncode == 0, out.stderr[-2000:]
 
 
-def test_a_declared_plugin_is_still_loaded_and_called(tmp_path: Path) -> None:
-    """A distribution declaring a ``pydantic`` entry point (as ``pip install`` of a plugin leaves it):
-    the cheap scan sees it, leaves pydantic to load it, and the plugin sees robocfg's validators."""
+def _spy_plugin(tmp_path: Path) -> Path:
+    """A distribution declaring a ``pydantic`` entry point (as ``pip install`` of a plugin leaves
+    it), whose plugin records the validators pydantic builds; its folder (for ``sys.path``)."""
     dist = tmp_path / "spy_plugin-1.0.dist-info"
     dist.mkdir()
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: spy-plugin\nVersion: 1.0\n")
@@ -61,6 +61,12 @@ def test_a_declared_plugin_is_still_loaded_and_called(tmp_path: Path) -> None:
                 return None, None, None
         plugin = _Plugin()
     """))
+    return tmp_path
+
+
+def test_a_declared_plugin_is_still_loaded_and_called(tmp_path: Path) -> None:
+    """The cheap scan sees a declared plugin, leaves pydantic to load it, and the plugin sees
+    robocfg's validators."""
     out = _python("""
         from robocfg.config.pydantic_plugins import declares_plugins
         assert declares_plugins() is True
@@ -69,5 +75,84 @@ def test_a_declared_plugin_is_still_loaded_and_called(tmp_path: Path) -> None:
         load_task(catalog.find('tasks', 'pick_place'))
         import spy_plugin
         assert 'PickPlaceTask' in spy_plugin.seen, spy_plugin.seen
-    """, tmp_path)
+    """, _spy_plugin(tmp_path))
+    assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_the_command_defers_importlib_metadata_and_still_calls_a_declared_plugin(tmp_path: Path) -> None:
+    """``robocfg validate``: typer's parameter adapters import pydantic's loader before robocfg's
+    models do; without a plugin the command still runs without ``importlib.metadata`` and its
+    loader's cache is filled; with one, the plugin is loaded and sees robocfg's models."""
+    run = """
+        import atexit, runpy, sys
+        def _check():
+            from pydantic.plugin import _loader
+            print('METADATA', 'importlib.metadata' in sys.modules, 'PLUGINS', _loader._plugins == {})
+            if 'spy_plugin' in sys.modules:
+                print('SEEN', sorted(set(sys.modules['spy_plugin'].seen)))
+        atexit.register(_check)
+        sys.argv = ['robocfg', 'validate', 'robocfg/data/tasks/pick_place.yaml']
+        runpy.run_module('robocfg', run_name='__main__')
+    """
+    plain = _python(run)
+    assert plain.returncode == 0, plain.stderr[-2000:]
+    assert "METADATA False PLUGINS True" in plain.stdout
+    spied = _python(run, _spy_plugin(tmp_path))
+    assert spied.returncode == 0, spied.stderr[-2000:]
+    assert "METADATA True PLUGINS False" in spied.stdout
+    seen = spied.stdout.split("SEEN", 1)[1]
+    assert "PickPlaceTask" in seen and "RobotConfig" in seen
+
+
+def test_validation_leaves_importlib_metadata_unimported_and_the_loader_working() -> None:
+    """pydantic's loader is imported with ``importlib.metadata`` deferred: a task validates (its
+    validators built) without importing it; the loader's ``entry_points`` then imports the real
+    module and answers as its own ``entry_points`` does."""
+    out = _python("""
+        import sys
+        from robocfg.checks.task import load_task
+        from robocfg.config import catalog
+        load_task(catalog.find('tasks', 'pick_place'))
+        from pydantic.plugin import _loader
+        assert _loader._plugins == {}, _loader._plugins
+        assert 'importlib.metadata' not in sys.modules
+        assert list(_loader.get_plugins()) == []
+        got = _loader.entry_points(group='console_scripts')
+        import importlib.metadata as md
+        assert type(sys.modules['importlib.metadata']) is type(sys)  # the real module from now on
+        assert got == md.entry_points(group='console_scripts') and len(got) > 0
+    """)
+    assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_disabled_plugins_still_defer_importlib_metadata() -> None:
+    """``PYDANTIC_DISABLE_PLUGINS`` set: robocfg leaves pydantic's cache alone (pydantic reads the
+    variable itself) and the loader still comes without ``importlib.metadata``."""
+    out = _python("""
+        import os, sys
+        os.environ['PYDANTIC_DISABLE_PLUGINS'] = '1'
+        from robocfg.checks.task import load_task
+        from robocfg.config import catalog
+        load_task(catalog.find('tasks', 'pick_place'))
+        from pydantic.plugin import _loader
+        assert _loader._plugins is None and 'importlib.metadata' not in sys.modules
+    """)
+    assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_a_name_other_than_entry_points_is_the_real_modules() -> None:
+    """The stand-in for ``importlib.metadata`` inside the loader's import: ``entry_points`` and any
+    other public name are the real module's (imported at that use), module attributes the import
+    system probes are absent, and afterwards ``import importlib.metadata`` gives the real module."""
+    out = _python("""
+        import sys
+        from robocfg.config.pydantic_plugins import METADATA, _DeferredMetadata
+        stand_in = _DeferredMetadata(METADATA)
+        assert not hasattr(stand_in, '__path__')
+        assert 'importlib.metadata' not in sys.modules
+        version = stand_in.version
+        import importlib.metadata as md
+        assert version is md.version and type(md) is type(sys)
+        assert stand_in.entry_points(group='pydantic') == md.entry_points(group='pydantic')
+    """)
     assert out.returncode == 0, out.stderr[-2000:]

@@ -72,6 +72,7 @@ def test_validating_a_pick_place_of_a_box_imports_no_trimesh(tmp_path) -> None:
     # the reach check ran (validate asks the kind's command face), the episode code was not loaded
     assert {"robocfg.motion.reach", "robocfg.runners.pick_place_command"} <= names
     assert sorted({"robocfg.runners.pick_place", "robocfg.runners.pick_place_machine", *OTHER_KINDS} & names) == []
+    assert "importlib.metadata" not in names  # pydantic's plugin loader without it (robocfg.config.pydantic_plugins)
 
 
 def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp_path) -> None:
@@ -93,6 +94,7 @@ def test_a_pick_place_process_to_its_first_episode_imports_only_what_it_runs(tmp
     assert [m for m in other_models if m in names] == []  # nor the other kinds' config models
     ik = {"robocfg.kinematics.ik.lm", "robocfg.kinematics.ik.pink_qp", "robocfg.kinematics.ik.placo_qp"}
     assert ik & names == {"robocfg.kinematics.ik.lm"}  # the IK backend it solves with, not the QP ones
+    assert "importlib.metadata" not in names  # pydantic's plugin loader without it (robocfg.config.pydantic_plugins)
 
 
 def test_lapack_routines_are_scipys_own_functions(tmp_path) -> None:

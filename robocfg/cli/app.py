@@ -90,14 +90,26 @@ app.add_typer(dataset.dataset_app, name="dataset")
 def main() -> None:
     """Console-script entry point."""
     from robocfg import collector
-    from robocfg.cli.common import debug_enabled, set_debug
-    from robocfg.cli.errors import describe
+    from robocfg.cli.common import set_debug
     from robocfg.cli.process import single_math_thread, skip_final_collection
+    from robocfg.config.pydantic_plugins import deferring
 
     collector.pause()  # no collections during the start: resumed once a world is built (robocfg.collector)
     single_math_thread()  # before numpy loads (robocfg.cli.process)
     skip_final_collection()  # before any command registers its own atexit handlers
     set_debug("--debug" in sys.argv[1:])
+    # pydantic's plugin loader, whoever imports it first (typer's parameter adapters do, before
+    # robocfg's models), without importlib.metadata (robocfg.config.pydantic_plugins)
+    with deferring():
+        _run()
+
+
+def _run() -> None:
+    """The command line run, its exceptions mapped to exit codes and messages."""
+    from robocfg import collector
+    from robocfg.cli.common import debug_enabled
+    from robocfg.cli.errors import describe
+
     try:
         rv = app(standalone_mode=False)
         sys.exit(rv if isinstance(rv, int) else 0)

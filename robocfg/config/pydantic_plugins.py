@@ -10,25 +10,43 @@ folders on ``sys.path``, as importlib.metadata finds them) and reads only their 
 files: when none declares the ``pydantic`` group, it fills pydantic's cache with the answer its own
 scan would give (no plugins). Anything it cannot answer as cheaply (a zip archive on ``sys.path``,
 another finder that lists distributions, an unreadable file, a pydantic without that cache) leaves
-pydantic to scan as usual; so does any declared plugin, which pydantic then loads itself. Importing
-pydantic's loader (and so ``importlib.metadata``, ≈ 0.03 s) is not spared: pydantic imports it
-before its first validator whatever the cache holds.
+pydantic to scan as usual; so does any declared plugin, which pydantic then loads itself.
+
+Importing pydantic's loader imported ``importlib.metadata`` (with ``email``, ``zipfile``, ``csv``,
+``socket`` and more: ≈ 58 M instructions, ≈ 0.02 s of CPU on the 2-core laptop) for the one name
+it binds, ``entry_points``, which the loader calls only to scan (never once its cache is filled).
+:func:`skip_empty_plugin_scan` therefore imports pydantic's loader itself, before pydantic does,
+with ``importlib.metadata`` standing in as a module whose ``entry_points`` imports the real module
+at its first call and calls its ``entry_points`` (any other name the loader takes from it is the
+real module's, imported then): the loader's own code, from its own bytecode, with one import
+deferred. Nothing else in a robocfg process before its first episode imports
+``importlib.metadata``; where something did already, or the loader is already imported, the loader
+is imported (or kept) as it is.
 """
 
 from __future__ import annotations
 
+import contextlib
+import importlib
 import os
 import sys
+from collections.abc import Iterator, Sequence
+from importlib.machinery import ModuleSpec, PathFinder
+from types import ModuleType
+from typing import TYPE_CHECKING, cast
+
+if TYPE_CHECKING:
+    from importlib.abc import Loader  # importlib.abc imports importlib.resources: ≈ 10 ms
 
 GROUP = "pydantic"  # pydantic.plugin._loader.PYDANTIC_ENTRY_POINT_GROUP
+LOADER = "pydantic.plugin._loader"  # the module of pydantic's plugin cache
+METADATA = "importlib.metadata"
 _SKIPPED = (FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError)  # importlib.metadata's
 
 
 def declares_plugins() -> bool | None:
     """Whether an installed distribution declares an entry point in the ``pydantic`` group: True,
     False, or None when this cheap scan cannot tell (then ask ``importlib.metadata``)."""
-    from importlib.machinery import PathFinder
-
     if any(hasattr(f, "find_distributions") and f is not PathFinder for f in sys.meta_path):
         return None  # another finder lists distributions: only importlib.metadata knows them
     for entry in sys.path:
@@ -69,16 +87,116 @@ def _sections(text: str) -> set[str]:
 def skip_empty_plugin_scan() -> bool:
     """Fill pydantic's plugin cache with "no plugins" when :func:`declares_plugins` is sure there
     are none and pydantic has not looked yet; True when it did. ``PYDANTIC_DISABLE_PLUGINS`` set:
-    nothing to do (pydantic reads it itself)."""
-    if os.environ.get("PYDANTIC_DISABLE_PLUGINS") is not None:
-        return False
+    the cache is left to pydantic, which reads that variable itself. Either way pydantic's loader
+    is imported with ``importlib.metadata`` deferred where neither is imported yet (module
+    docstring); the fill then happens as the loader is imported."""
+    if LOADER not in sys.modules and METADATA not in sys.modules:
+        with deferring():
+            try:
+                importlib.import_module(LOADER)
+            except ImportError:
+                return False
+        return _filled
     try:
         from pydantic.plugin import _loader
     except ImportError:
         return False
-    if getattr(_loader, "_plugins", ()) is not None or getattr(_loader, "_loading_plugins", True) is not False:
+    return _fill(_loader)
+
+
+_filled = False  # the last import of the loader through _DeferringLoader filled its cache
+
+
+def _fill(loader: ModuleType) -> bool:
+    """``loader._plugins = {}`` where the scan is sure no plugin is declared (see above)."""
+    if os.environ.get("PYDANTIC_DISABLE_PLUGINS") is not None:
+        return False
+    if getattr(loader, "_plugins", ()) is not None or getattr(loader, "_loading_plugins", True) is not False:
         return False  # pydantic already looked (or is looking), or keeps its cache elsewhere
     if declares_plugins() is not False:
         return False
-    _loader._plugins = {}
+    loader._plugins = {}  # type: ignore[attr-defined]
     return True
+
+
+@contextlib.contextmanager
+def deferring() -> Iterator[None]:
+    """While inside: an import of pydantic's loader (by anyone: robocfg's models, typer's parameter
+    adapters) runs with ``importlib.metadata`` deferred and fills the cache (:func:`_fill`).
+    The ``robocfg`` command stays inside from its start to its end (``robocfg.cli.app.main``);
+    otherwise only :func:`skip_empty_plugin_scan` enters it, around its own import."""
+    if _LoaderFinder in sys.meta_path:
+        yield
+        return
+    sys.meta_path.insert(0, _LoaderFinder)
+    try:
+        yield
+    finally:
+        with contextlib.suppress(ValueError):
+            sys.meta_path.remove(_LoaderFinder)
+
+
+class _LoaderFinder:
+    """The ``sys.meta_path`` entry of :func:`deferring`: finds pydantic's loader as the path finder
+    does, with its execution wrapped (:class:`_DeferringLoader`); every other module, and the
+    loader once ``importlib.metadata`` is imported, it leaves to the finders after it."""
+
+    @staticmethod
+    def find_spec(name: str, path: Sequence[str] | None = None, target: ModuleType | None = None) -> ModuleSpec | None:
+        if name != LOADER or METADATA in sys.modules:
+            return None
+        spec = PathFinder.find_spec(name, path, target)
+        if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+            return None
+        spec.loader = cast("Loader", _DeferringLoader(spec.loader))  # a loader by protocol (no importlib.abc)
+        return spec
+
+
+class _DeferringLoader:
+    """Executes pydantic's loader module with its own loader (its bytecode), ``importlib.metadata``
+    standing in as :class:`_DeferredMetadata` meanwhile; then fills its cache (:func:`_fill`).
+    The module is left with its own loader in ``__loader__`` and ``__spec__.loader``."""
+
+    def __init__(self, loader: Loader) -> None:
+        self.loader = loader
+
+    def create_module(self, spec: ModuleSpec) -> ModuleType | None:
+        return self.loader.create_module(spec)
+
+    def exec_module(self, module: ModuleType) -> None:
+        global _filled
+        if module.__spec__ is not None:
+            module.__spec__.loader = self.loader
+        module.__loader__ = self.loader
+        stand_in = _DeferredMetadata(METADATA)
+        sys.modules[METADATA] = stand_in
+        try:
+            self.loader.exec_module(module)
+        finally:
+            if sys.modules.get(METADATA) is stand_in:
+                del sys.modules[METADATA]
+        _filled = _fill(module)
+
+
+class _DeferredMetadata(ModuleType):
+    """What ``import importlib.metadata`` gives while pydantic's loader is executed: its
+    ``entry_points`` imports the real module and calls the real function; any other attribute
+    is the real module's (imported at that access; the module attributes the import system asks for,
+    ``__path__`` for one, are absent as on a plain module)."""
+
+    @staticmethod
+    def entry_points(**params: object) -> object:
+        """``importlib.metadata.entry_points(**params)``."""
+        return _real_metadata().entry_points(**params)
+
+    def __getattr__(self, name: str) -> object:
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(_real_metadata(), name)
+
+
+def _real_metadata() -> ModuleType:
+    """The real ``importlib.metadata`` (imported now if it is not yet)."""
+    if isinstance(sys.modules.get(METADATA), _DeferredMetadata):
+        del sys.modules[METADATA]  # a use inside the loader's execution: the real module from now on
+    return importlib.import_module(METADATA)
