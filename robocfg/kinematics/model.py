@@ -49,17 +49,28 @@ def _urdf_xml_without_continuous(path: str) -> tuple[str, frozenset[str]]:
     pinocchio models continuous joints with two coordinates (cos, sin); one angle per joint keeps
     the interface simple. Returns (xml text, names of the converted joints); remembered per file
     (path, size, mtime): a process builds several models of one robot before its first episode.
+
+    A file that cannot hold a continuous joint (the word ``continuous`` nowhere in it) and is plain
+    ASCII (no encoding or byte-order mark to interpret) is returned as read: nothing to convert, and
+    pinocchio builds the same model from it as from the parsed and re-serialised tree (compared for
+    every shipped robot in ``tests/test_kinematics_model_memo.py``), without the ≈ 2 ms round trip.
     """
-    from robocfg.assets.urdf_xml import read_urdf_xml, revolute_continuous
+    from pathlib import Path
 
     st = os.stat(path)
     key = (path, st.st_size, st.st_mtime_ns)
     if key not in _XML_MEMO:
         if len(_XML_MEMO) >= 16:
             _XML_MEMO.pop(next(iter(_XML_MEMO)))
-        root = read_urdf_xml(path)
-        converted = revolute_continuous(root, math.pi)
-        _XML_MEMO[key] = (ET.tostring(root, encoding="unicode"), frozenset(converted))
+        data = Path(path).read_bytes()
+        if b"continuous" not in data and data.isascii():
+            _XML_MEMO[key] = (data.decode("ascii"), frozenset())
+        else:
+            from robocfg.assets.urdf_xml import read_urdf_xml, revolute_continuous
+
+            root = read_urdf_xml(path)
+            converted = revolute_continuous(root, math.pi)
+            _XML_MEMO[key] = (ET.tostring(root, encoding="unicode"), frozenset(converted))
     return _XML_MEMO[key]
 
 
@@ -118,7 +129,39 @@ class KinematicModel:
         ``gripper_q``: joint name → value for locked joints (default: gripper ``open``,
         other arms at ``home``, anything else 0 clipped into its limits); mimic followers follow
         their leader (``multiplier · q + offset``).
+
+        Each call returns a new model that shares nothing mutable with another: its own pinocchio
+        ``Model`` and ``Data``, arrays and solvers. The same arguments give the same model; the
+        last few builds are kept (:func:`_remembered`) and copied, since a run builds one twice
+        before its first episode (the reach check, then the session).
         """
+        key = _build_key(robot, arm, base_pose, gripper_q)
+        built = _remembered(key, robot) if key is not None else None
+        if built is None:
+            built = cls._build(robot, arm, base_pose, gripper_q)
+            if key is not None:
+                _remember(key, robot, built)
+        return built.copy_for(robot)
+
+    def copy_for(self, robot: CheckedRobot | None) -> KinematicModel:
+        """A new model equal to this one (a copy of the pinocchio model, new data, no solvers or
+        cached lookups yet) whose source config is ``robot``."""
+        return type(self)(
+            model=pin.Model(self.model), data=self.model.createData(), joint_names=list(self.joint_names),
+            lower=self.lower.copy(), upper=self.upper.copy(), velocity_limits=self.velocity_limits.copy(),
+            wrap=self.wrap.copy(), ee_link=self.ee_link, home=self.home.copy(), base_pose=self.base_pose.copy(),
+            urdf_path=self.urdf_path, locked=dict(self.locked), default_backend=self.default_backend, robot=robot,
+            continuous=None if self.continuous is None else self.continuous.copy())
+
+    @classmethod
+    def _build(
+        cls,
+        robot: CheckedRobot,
+        arm: str | None,
+        base_pose: np.ndarray | None,
+        gripper_q: dict[str, float] | None,
+    ) -> KinematicModel:
+        """The model :meth:`from_robot` describes, built from the URDF."""
         cfg = robot.config
         arm_cfg = cfg.arm(arm)
         xml, continuous = _urdf_xml_without_continuous(str(robot.urdf_path))
@@ -332,6 +375,43 @@ class KinematicModel:
         if q.shape[0] != self.nq:
             raise RobocfgError(f"expected {self.nq} joint values ({', '.join(self.joint_names)}), got {q.shape[0]}")
         return q
+
+
+# (key, robot config, parsed URDF, model): the last builds, newest last (see _remembered)
+_BUILT: list[tuple[tuple, object, object, KinematicModel]] = []
+BUILT_SIZE = 4
+
+
+def _build_key(robot: CheckedRobot, arm: str | None, base_pose: np.ndarray | None,
+               gripper_q: dict[str, float] | None) -> tuple | None:
+    """What :meth:`KinematicModel.from_robot` reads besides the robot's config and parsed URDF
+    (compared by identity in :func:`_remembered`): the URDF file (path, size, mtime, as the XML is
+    remembered), the arm, the base pose's bits and the locked-joint overrides. None (not
+    remembered) for a file that cannot be read or a base pose that is not an array of numbers:
+    the build reports those."""
+    try:
+        st = os.stat(robot.urdf_path)
+        T = None if base_pose is None else np.asarray(base_pose, dtype=float)
+        q = tuple(sorted((str(k), float(v)) for k, v in (gripper_q or {}).items()))
+    except (OSError, TypeError, ValueError):
+        return None
+    pose = None if T is None else (T.shape, T.tobytes())
+    return (str(robot.urdf_path), st.st_size, st.st_mtime_ns, arm, pose, q)
+
+
+def _remembered(key: tuple, robot: CheckedRobot) -> KinematicModel | None:
+    """The model built for ``key`` from this very config and parsed URDF (the same objects: a
+    frozen config, and the URDF parsed once per checked robot), if it is one of the last few."""
+    for k, config, urdf, model in _BUILT:
+        if k == key and config is robot.config and urdf is robot.urdf:
+            return model
+    return None
+
+
+def _remember(key: tuple, robot: CheckedRobot, model: KinematicModel) -> None:
+    if len(_BUILT) >= BUILT_SIZE:
+        _BUILT.pop(0)
+    _BUILT.append((key, robot.config, robot.urdf, model))
 
 
 def _se3(T: np.ndarray, what: str) -> pin.SE3:
