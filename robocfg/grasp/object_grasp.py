@@ -25,7 +25,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from robocfg.assets.object_shape import FINGER_CLEARANCE, ObjectShape
-from robocfg.grasp.antipodal import PlannerSettings, plan_grasps
 from robocfg.grasp.gripper_model import GripperBoxes
 from robocfg.kinematics.frames import Grasp, grasp_rotation
 
@@ -178,6 +177,10 @@ def mesh_grasps(obj: LyingObject, boxes: GripperBoxes, rng: np.random.Generator,
     ``MESH_POOL``, those whose closing line passes nearest the centre of mass first (``lever_arm``:
     two pads hold an object against turning about that line by friction alone, so gravity's lever
     about it is what tips the object in the hand), the planner's order among equals."""
+    # imported here: only a mesh object needs the planner (its modules cost a pick-place process's
+    # start ≈ 1 ms otherwise)
+    from robocfg.grasp.antipodal import PlannerSettings, plan_grasps
+
     pts, nrm = obj.shape.surface(SURFACE_POINTS, rng)
     P = pts @ obj.rotation.T + obj.position
     N = nrm @ obj.rotation.T

@@ -15,7 +15,6 @@ import numpy as np
 
 from robocfg.config.commands import Limits, PickPlaceParams
 from robocfg.config.robot import ParallelGripperConfig
-from robocfg.datasets.language import pick_place_instruction
 from robocfg.engine.dataset import ReplayScene
 from robocfg.engine.options import FrameRecorder, RunOptions
 from robocfg.engine.randomize import place_randomly
@@ -121,7 +120,7 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
             setup = episode_setup(self.params, self.seed, k)
             return not_simulated(setup, self.blocked.phase, f"{self.blocked.reason}; checked before simulating")
         sm = self._machine(k, recorder)
-        self.record_from(self.handle, sm.obj, lambda: sm.mover.phase, lambda: pick_place_instruction(self.params))
+        self.record_from(self.handle, sm.obj, lambda: sm.mover.phase, self._instruction)
         try:
             sm.run()
             failed, reason = None, "placed"
@@ -129,6 +128,12 @@ class PickPlaceSession(EpisodeSession[EpisodeResult]):
             failed, reason = exc.phase, exc.reason
             sm.close_phase(False, reason)
         return sm.result(failed, reason)
+
+    def _instruction(self) -> str:
+        """The episode's language instruction (asked only when a dataset records it)."""
+        from robocfg.datasets.language import pick_place_instruction
+
+        return pick_place_instruction(self.params)
 
     def scene(self, k: int) -> ReplayScene:
         sm = self._machine(k, None)

@@ -33,7 +33,6 @@ from robocfg.checks.robot import CheckedRobot
 from robocfg.config.robot import ParallelGripperConfig
 from robocfg.errors import ConfigError
 from robocfg.sim.quiet import captured_stdout
-from robocfg.sim.visuals import split_by_material
 
 if TYPE_CHECKING:
     from robocfg.sim.robot import RobotHandle
@@ -93,12 +92,15 @@ def _decompose_finger_meshes(root: ET.Element, robot: CheckedRobot) -> bool:
     decomposition (``robocfg.sim.concave``): PyBullet would collide with one hull filling the
     space between the jaws."""
     from robocfg.config.robot import OneJawGripperConfig
-    from robocfg.sim.concave import convex_parts
 
     # One-jaw grippers only: their fixed jaw is typically part of the hand's mesh. Two-finger
     # grippers keep PyBullet's hulls (their physics, and the shipped robots' figures, unchanged).
     fingers = {f for arm in robot.config.arms if isinstance(arm.gripper, OneJawGripperConfig)
                for f in arm.gripper.finger_links}
+    if not fingers:
+        return False
+    from robocfg.sim.concave import convex_parts  # imported for one-jaw grippers only
+
     changed = False
     for link in root.findall("link"):
         if link.get("name") not in fingers:
@@ -131,6 +133,8 @@ def _split_multi_material_visuals(root: ET.Element) -> bool:
             fn = Path(mesh.get("filename", ""))
             if fn.suffix.lower() != ".obj" or not fn.is_absolute() or not fn.is_file():
                 continue
+            from robocfg.sim.visuals import split_by_material  # imported for uncoloured OBJ visuals only
+
             parts = split_by_material(fn)
             if not parts:
                 continue
