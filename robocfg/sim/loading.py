@@ -133,7 +133,8 @@ def _split_multi_material_visuals(root: ET.Element) -> bool:
             fn = Path(mesh.get("filename", ""))
             if fn.suffix.lower() != ".obj" or not fn.is_absolute() or not fn.is_file():
                 continue
-            from robocfg.sim.visuals import split_by_material  # imported for uncoloured OBJ visuals only
+            # imported for uncoloured OBJ visuals only
+            from robocfg.sim.visuals import split_by_material
 
             parts = split_by_material(fn)
             if not parts:
