@@ -47,10 +47,13 @@ def finger_points(urdf: Urdf, resolver: Resolver, finger_links: list[str]) -> li
 
 
 def pad_points(urdf: Urdf, ee_link: str, finger_links: list[str], points: list[np.ndarray],
-               q: dict[str, float], axis: int, memo: dict | None = None) -> list[np.ndarray]:
+               q: dict[str, float], axis: int, memo: dict | None = None,
+               ee_inv: np.ndarray | None = None) -> list[np.ndarray]:
     """Pad points of each finger in the ``ee_link`` frame at gripper joint values ``q``
-    (``memo``: :meth:`Urdf.link_pose`'s, kept over a sweep of ``q``)."""
-    T_ee_inv = np.linalg.inv(urdf.link_pose(ee_link, q, memo))
+    (``memo``: :meth:`Urdf.link_pose`'s, kept over a sweep of ``q``; ``ee_inv``: the inverse of
+    ``ee_link``'s pose at ``q`` when the caller has it, e.g. one for a whole sweep of joints that do
+    not move ``ee_link``)."""
+    T_ee_inv = np.linalg.inv(urdf.link_pose(ee_link, q, memo)) if ee_inv is None else ee_inv
     out = []
     for name, P in zip(finger_links, points, strict=True):
         T = T_ee_inv @ urdf.link_pose(name, q, memo)
@@ -94,7 +97,12 @@ def width_curve(urdf: Urdf, resolver: Resolver, ee_link: str, ee_axis: int, fing
     qo, qc = np.asarray(q_open, float), np.asarray(q_closed, float)
     s = np.linspace(0.0, 1.0, n)
     memo: dict = {}  # the arm's chain to the hand is the same at every s
-    gaps = np.array([pad_gap(pad_points(urdf, ee_link, finger_links, points,
-                                        dict(zip(leaders, qc + k * (qo - qc), strict=True)), ee_axis, memo), closing)
-                     for k in s])
+    qs = [dict(zip(leaders, qc + k * (qo - qc), strict=True)) for k in s]
+    # ee_link's pose does not change over the sweep unless a swept joint (a leader or one of its
+    # mimic followers) is on its chain: then its inverse is the same at every s, computed once
+    moved = {j.name for j in urdf.joints.values() if j.name in leaders or (j.mimic is not None and j.mimic.joint in leaders)}
+    fixed = not any(j.name in moved for j in urdf.chain(urdf.root, ee_link) or [])
+    ee_inv = np.linalg.inv(urdf.link_pose(ee_link, qs[0], memo)) if fixed and qs else None
+    gaps = np.array([pad_gap(pad_points(urdf, ee_link, finger_links, points, q, ee_axis, memo, ee_inv), closing)
+                     for q in qs])
     return s, gaps
