@@ -143,17 +143,18 @@ def measure_gripper(robot: RobotHandle, arm: ArmHandle) -> GripperBoxes:
     """Boxes of ``arm``'s gripper measured open, then at ``CLOSING_SAMPLES`` openings down to closed
     (the gripper is teleported and back open: call it before taking a snapshot). Links without a
     collision shape are skipped; finger links are the gripper's ``finger_links``."""
-    from robocfg.sim.link_boxes import measure_link_boxes
+    from robocfg.sim.link_boxes import gripper_layout, measure_link_boxes
 
     g = arm.gripper
     G_T_ee = grasp_from_ee(arm.config)
-    m = measure_link_boxes(robot, arm, G_T_ee)
+    layout = gripper_layout(robot, arm)  # links and shapes, read once for all the openings
+    m = measure_link_boxes(robot, arm, G_T_ee, layout)
     lo, hi, names, finger = m.lo, m.hi, m.names, m.finger
     samples = [_sample(m, finger)]
     if g is not None:
         for f in np.linspace(1.0, 0.0, CLOSING_SAMPLES)[1:]:
             g.reset(float(f))
-            s = measure_link_boxes(robot, arm, G_T_ee)
+            s = measure_link_boxes(robot, arm, G_T_ee, layout)
             if s.names == names:
                 samples.append(_sample(s, finger))
         g.reset(1.0)

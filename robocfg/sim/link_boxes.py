@@ -45,21 +45,45 @@ class LinkBoxes:
     obbs: tuple[OrientedBox, ...]
 
 
-def measure_link_boxes(robot: RobotHandle, arm: ArmHandle, grasp_T_ee: np.ndarray) -> LinkBoxes:
-    """Boxes of ``arm``'s gripper links in its current state; ``grasp_T_ee`` (4x4) places the grasp
-    frame relative to ``ee_link``. Raises ValueError when no finger link has a collision shape."""
+@dataclass(frozen=True)
+class GripperLayout:
+    """What measuring ``arm``'s gripper reads from PyBullet that its joints do not change: the
+    links (``ee_link`` first, then those below it), the finger links and the links a finger is
+    fixed to, and each link's collision shapes (:func:`_shape_points`: points, m, and the shape's
+    pose in the link's inertial frame, None for a mesh)."""
 
+    links: tuple[int, ...]
+    fingers: frozenset[str]
+    touching: frozenset[str]
+    shapes: tuple[tuple[tuple[np.ndarray, np.ndarray | None], ...], ...]
+
+
+def gripper_layout(robot: RobotHandle, arm: ArmHandle) -> GripperLayout:
+    """The :class:`GripperLayout` of ``arm``'s gripper (read once for a series of measurements)."""
     c, body = robot.client, robot.body_id
     cfg = arm.config
     ee = robot.link(cfg.ee_link)
-    below = _links_below(c, body, ee)
-    T_ee = arm.ee_pose()
-    G_T_world = grasp_T_ee @ np.linalg.inv(T_ee)
+    links = (ee, *_links_below(c, body, ee))
     fingers = set(cfg.gripper.finger_links) if isinstance(cfg.gripper, ParallelGripperConfig) else set()
     touching = fingers | _rigid_parents(robot, fingers)
+    return GripperLayout(links, frozenset(fingers), frozenset(touching), tuple(_shape_points(c, body, li) for li in links))
+
+
+def measure_link_boxes(robot: RobotHandle, arm: ArmHandle, grasp_T_ee: np.ndarray,
+                       layout: GripperLayout | None = None) -> LinkBoxes:
+    """Boxes of ``arm``'s gripper links in its current state; ``grasp_T_ee`` (4x4) places the grasp
+    frame relative to ``ee_link``; ``layout``: :func:`gripper_layout` of this arm, read earlier
+    (default: read now). Raises ValueError when no finger link has a collision shape."""
+
+    c, body = robot.client, robot.body_id
+    if layout is None:
+        layout = gripper_layout(robot, arm)
+    T_ee = arm.ee_pose()
+    G_T_world = grasp_T_ee @ np.linalg.inv(T_ee)
+    fingers, touching = layout.fingers, layout.touching
     lo, hi, names, finger, obbs = [], [], [], [], []
-    for li in [ee, *below]:
-        pts, T_com = _collision_points(c, body, li)
+    for li, shapes in zip(layout.links, layout.shapes, strict=True):
+        pts, T_com = _collision_points(c, body, li, shapes)
         if len(pts) == 0:
             continue
         g = pts @ G_T_world[:3, :3].T + G_T_world[:3, 3]
@@ -102,11 +126,25 @@ def _links_below(client: int, body: int, link: int) -> list[int]:
     return out
 
 
-def _collision_points(client: int, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
-    """World points spanning the collision shapes of ``link`` (mesh vertices from PyBullet's
-    ``getMeshData``, given in the link's inertial frame; primitive-shape corners otherwise) and
-    the world pose of that inertial frame."""
-    shapes = p.getCollisionShapeData(body, link, physicsClientId=client)
+def _shape_points(client: int, body: int, link: int) -> tuple[tuple[np.ndarray, np.ndarray | None], ...]:
+    """The collision shapes of ``link``: per shape, its points (mesh vertices from PyBullet's
+    ``getMeshData``, given in the link's inertial frame; primitive-shape corners in the shape's
+    frame otherwise) and the shape's pose in the inertial frame (None for a mesh). The same
+    whatever the joints' state: a shape's vertices are stored in its own frame."""
+    out: list[tuple[np.ndarray, np.ndarray | None]] = []
+    for k, s in enumerate(p.getCollisionShapeData(body, link, physicsClientId=client)):
+        if s[2] == p.GEOM_MESH:
+            n, verts = p.getMeshData(body, link, collisionShapeIndex=k, physicsClientId=client)[:2]
+            out.append((np.asarray(verts, float).reshape(-1, 3) if n else np.zeros((0, 3)), None))
+        else:
+            out.append((_primitive_corners(s[2], s[3]), pose_to_matrix(s[5], s[6])))
+    return tuple(out)
+
+
+def _collision_points(client: int, body: int, link: int,
+                      shapes: tuple[tuple[np.ndarray, np.ndarray | None], ...]) -> tuple[np.ndarray, np.ndarray]:
+    """World points spanning the collision ``shapes`` of ``link`` (:func:`_shape_points`) and the
+    world pose of the link's inertial frame."""
     if not shapes:
         return np.zeros((0, 3)), np.eye(4)
     if link >= 0:
@@ -116,14 +154,8 @@ def _collision_points(client: int, body: int, link: int) -> tuple[np.ndarray, np
         pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=client)
         T_com = pose_to_matrix(pos, orn)
     out = []
-    for k, s in enumerate(shapes):
-        if s[2] == p.GEOM_MESH:
-            n, verts = p.getMeshData(body, link, collisionShapeIndex=k, physicsClientId=client)[:2]
-            local = np.asarray(verts, float).reshape(-1, 3) if n else np.zeros((0, 3))
-            T = T_com
-        else:
-            local = _primitive_corners(s[2], s[3])
-            T = T_com @ pose_to_matrix(s[5], s[6])
+    for local, pose in shapes:
+        T = T_com if pose is None else T_com @ pose
         if len(local):
             out.append(local @ T[:3, :3].T + T[:3, 3])
     return (np.concatenate(out) if out else np.zeros((0, 3))), T_com
