@@ -12,8 +12,9 @@ range spans 2π or more are *wrapped* (not clamped) by the IK solvers.
 
 pinocchio is imported here: import this module lazily from the CLI.
 
-Length (≈ 310 lines): one concept, the model's construction and its queries (FK, sampled FK
-positions, Jacobians, IK dispatch); the IK solvers themselves live in :mod:`robocfg.kinematics.ik`.
+Length (≈ 450 lines): one concept, the model's construction (the last few builds kept and
+copied) and its queries (FK, sampled FK positions, Jacobians, IK dispatch); the IK solvers
+themselves live in :mod:`robocfg.kinematics.ik`.
 """
 
 from __future__ import annotations
