@@ -156,3 +156,41 @@ def test_a_name_other_than_entry_points_is_the_real_modules() -> None:
         assert stand_in.entry_points(group='pydantic') == md.entry_points(group='pydantic')
     """)
     assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_another_thread_importing_importlib_metadata_meanwhile_gets_the_real_module() -> None:
+    """Another thread that imports ``importlib.metadata`` while pydantic's loader module executes
+    (here: at the loader's first line, run from a trace function, one moment of that window) gets
+    the real module by every spelling, never the stand-in: an import of a module found in
+    ``sys.modules`` takes no lock (the loader's import holds only its own module's lock), so a
+    stand-in there was what that thread got (and ``importlib.metadata.version`` an AttributeError,
+    the import of a module already in ``sys.modules`` leaving its parent package's attribute unset).
+    Afterwards the loader still runs without having imported the real module, and
+    ``builtins.__import__`` is the interpreter's own."""
+    out = _python("""
+        import builtins, sys, threading
+        own_import = builtins.__import__
+        got = {}
+        def other():
+            import importlib.metadata as m
+            got['as'] = type(m).__name__, getattr(m, '__file__', None) is not None
+            import importlib.metadata
+            got['dotted'] = importlib.metadata.version('pydantic')
+            from importlib import metadata
+            got['from'] = metadata is m
+        def tracer(frame, event, arg):
+            code = frame.f_code
+            if event == 'call' and code.co_name == '<module>' and code.co_filename.endswith('_loader.py') and not got:
+                t = threading.Thread(target=other)
+                t.start()
+                t.join()
+        sys.settrace(tracer)
+        import robocfg.config.types
+        sys.settrace(None)
+        assert got['as'] == ('module', True), got
+        assert got['from'] is True and got['dotted'], got
+        from pydantic.plugin import _loader
+        assert _loader._plugins == {} and builtins.__import__ is own_import
+        assert type(sys.modules['importlib.metadata']) is type(sys)
+    """)
+    assert out.returncode == 0, out.stderr[-2000:]

@@ -26,11 +26,12 @@ is imported (or kept) as it is.
 
 from __future__ import annotations
 
+import builtins
 import contextlib
 import importlib
 import os
 import sys
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from importlib.machinery import ModuleSpec, PathFinder
 from types import ModuleType
 from typing import TYPE_CHECKING, cast
@@ -153,9 +154,11 @@ class _LoaderFinder:
 
 
 class _DeferringLoader:
-    """Executes pydantic's loader module with its own loader (its bytecode), ``importlib.metadata``
-    standing in as :class:`_DeferredMetadata` meanwhile; then fills its cache (:func:`_fill`).
-    The module is left with its own loader in ``__loader__`` and ``__spec__.loader``."""
+    """Executes pydantic's loader module with its own loader (its bytecode), its ``from
+    importlib.metadata import ...`` answered by :class:`_DeferredMetadata` meanwhile (through
+    ``builtins.__import__`` for that one statement of that one module; ``sys.modules`` is left
+    alone); then fills its cache (:func:`_fill`). The module is left with its own loader in
+    ``__loader__`` and ``__spec__.loader``."""
 
     def __init__(self, loader: Loader) -> None:
         self.loader = loader
@@ -169,17 +172,30 @@ class _DeferringLoader:
             module.__spec__.loader = self.loader
         module.__loader__ = self.loader
         stand_in = _DeferredMetadata(METADATA)
-        sys.modules[METADATA] = stand_in
+        namespace = module.__dict__
+        own_import = builtins.__import__
+
+        def scoped_import(name: str, globals: Mapping[str, object] | None = None,
+                          locals: Mapping[str, object] | None = None, fromlist: Sequence[str] | None = (),
+                          level: int = 0) -> ModuleType:
+            # the stand-in answers only the loader's own ``from importlib.metadata import ...``;
+            # any other import, in any thread, is the interpreter's (``sys.modules`` never holds
+            # the stand-in: another thread importing importlib.metadata meanwhile would get it)
+            if name == METADATA and fromlist and not level and globals is namespace:
+                return stand_in
+            return own_import(name, globals, locals, fromlist or (), level)
+
+        builtins.__import__ = scoped_import
         try:
             self.loader.exec_module(module)
         finally:
-            if sys.modules.get(METADATA) is stand_in:
-                del sys.modules[METADATA]
+            if builtins.__import__ is scoped_import:
+                builtins.__import__ = own_import
         _filled = _fill(module)
 
 
 class _DeferredMetadata(ModuleType):
-    """What ``import importlib.metadata`` gives while pydantic's loader is executed: its
+    """What pydantic's loader module imports from ``importlib.metadata`` as it is executed: its
     ``entry_points`` imports the real module and calls the real function; any other attribute
     is the real module's (imported at that access; the module attributes the import system asks for,
     ``__path__`` for one, are absent as on a plain module)."""
@@ -197,6 +213,4 @@ class _DeferredMetadata(ModuleType):
 
 def _real_metadata() -> ModuleType:
     """The real ``importlib.metadata`` (imported now if it is not yet)."""
-    if isinstance(sys.modules.get(METADATA), _DeferredMetadata):
-        del sys.modules[METADATA]  # a use inside the loader's execution: the real module from now on
     return importlib.import_module(METADATA)
