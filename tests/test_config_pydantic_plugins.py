@@ -194,3 +194,41 @@ def test_another_thread_importing_importlib_metadata_meanwhile_gets_the_real_mod
         assert type(sys.modules['importlib.metadata']) is type(sys)
     """)
     assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_the_loader_of_pydantic_2_13_spelling_its_import_without_a_from_list_is_deferred_too(tmp_path: Path) -> None:
+    """pydantic 2.13 (pyproject's lower bound) writes ``import importlib.metadata as
+    importlib_metadata`` and calls ``importlib_metadata.distributions()`` in its scan; a loader
+    module spelt so, executed as robocfg executes pydantic's, binds the stand-in (its
+    ``distributions`` the real function, imported at that use), imports no ``importlib.metadata``,
+    and a plain ``import importlib.metadata`` there gives an ``importlib`` whose other names are
+    the real package's."""
+    (tmp_path / "loader_2_13.py").write_text(textwrap.dedent("""
+        from __future__ import annotations
+
+        import importlib.metadata as importlib_metadata
+        import importlib.metadata
+        import os
+        import warnings
+
+        _plugins = None
+        _loading_plugins = False
+    """))
+    out = _python(f"""
+        import importlib.util, sys
+        from robocfg.config.pydantic_plugins import _DeferredMetadata, _DeferringLoader
+        spec = importlib.util.spec_from_file_location('loader_2_13', {str(tmp_path / 'loader_2_13.py')!r})
+        spec.loader = _DeferringLoader(spec.loader)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        assert isinstance(module.importlib_metadata, _DeferredMetadata), module.importlib_metadata
+        assert module.importlib.metadata is module.importlib_metadata
+        assert 'importlib.metadata' not in sys.modules
+        assert module._plugins == {{}}  # no distribution declares a plugin here: the cache filled
+        assert module.importlib.import_module is importlib.import_module
+        names = {{d.metadata['Name'] for d in module.importlib_metadata.distributions()}}
+        import importlib.metadata as md
+        assert names == {{d.metadata['Name'] for d in md.distributions()}} and 'pydantic' in names
+        assert type(sys.modules['importlib.metadata']) is type(sys)
+    """)
+    assert out.returncode == 0, out.stderr[-2000:]

@@ -154,8 +154,8 @@ class _LoaderFinder:
 
 
 class _DeferringLoader:
-    """Executes pydantic's loader module with its own loader (its bytecode), its ``from
-    importlib.metadata import ...`` answered by :class:`_DeferredMetadata` meanwhile (through
+    """Executes pydantic's loader module with its own loader (its bytecode), its import of
+    ``importlib.metadata`` answered by :class:`_DeferredMetadata` meanwhile (through
     ``builtins.__import__`` for that one statement of that one module; ``sys.modules`` is left
     alone); then fills its cache (:func:`_fill`). The module is left with its own loader in
     ``__loader__`` and ``__spec__.loader``."""
@@ -178,11 +178,13 @@ class _DeferringLoader:
         def scoped_import(name: str, globals: Mapping[str, object] | None = None,
                           locals: Mapping[str, object] | None = None, fromlist: Sequence[str] | None = (),
                           level: int = 0) -> ModuleType:
-            # the stand-in answers only the loader's own ``from importlib.metadata import ...``;
+            # the stand-in answers only the loader's own import of importlib.metadata: ``from
+            # importlib.metadata import ...`` (pydantic ≥ 2.14) or ``import importlib.metadata as
+            # ...`` (2.13: the ``importlib`` package it gives holds the stand-in as ``metadata``);
             # any other import, in any thread, is the interpreter's (``sys.modules`` never holds
             # the stand-in: another thread importing importlib.metadata meanwhile would get it)
-            if name == METADATA and fromlist and not level and globals is namespace:
-                return stand_in
+            if name == METADATA and not level and globals is namespace:
+                return stand_in if fromlist else _DeferredPackage(stand_in)
             return own_import(name, globals, locals, fromlist or (), level)
 
         builtins.__import__ = scoped_import
@@ -209,6 +211,18 @@ class _DeferredMetadata(ModuleType):
         if name.startswith("__"):
             raise AttributeError(name)
         return getattr(_real_metadata(), name)
+
+
+class _DeferredPackage(ModuleType):
+    """The ``importlib`` package as ``import importlib.metadata [as name]`` gives it to pydantic's
+    loader: its ``metadata`` is the stand-in, any other attribute the real package's."""
+
+    def __init__(self, metadata: _DeferredMetadata) -> None:
+        super().__init__("importlib")
+        self.metadata = metadata
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(importlib, name)
 
 
 def _real_metadata() -> ModuleType:
