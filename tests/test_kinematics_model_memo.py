@@ -7,6 +7,7 @@ same model, sharing nothing mutable, and an IK query on one leaves the other's a
 
 from __future__ import annotations
 
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
@@ -97,3 +98,60 @@ def test_ik_on_one_copy_leaves_the_answers_of_the_next_unchanged() -> None:
         x = fresh.ik(T, time_budget=0.2)
         y = again.ik(T, time_budget=0.2)
         assert np.array_equal(x.q, y.q) and x.pos_err == y.pos_err and x.iterations == y.iterations
+
+
+_TWO_LINKS = """<?xml version="1.0"?>{doctype}
+<robot name="r">{pi}
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="tip"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="tip"/>
+    <origin xyz="{xyz}" rpy="0 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+_REFUSED_AS_READ = pytest.mark.parametrize("doctype,pi,xyz", [
+    ("", "", "0 0\t0.333"),  # a tab inside a number
+    ('\n<!DOCTYPE robot [<!ENTITY h "0.333">]>', "", "0 0 &h;"),  # a DOCTYPE with an internal entity
+    ("", "\n  <?editor keep?>", "0 0 0.333"),  # a processing instruction inside the document
+], ids=["tab-in-number", "doctype-entity", "processing-instruction"])
+
+
+def _refused_as_read(tmp_path: Path, doctype: str, pi: str, xyz: str) -> tuple[Path, pin.Model]:
+    """The two-link file and the model its ElementTree round trip gives (asserting urdfdom refuses
+    the text as written, the case these tests are about)."""
+    path = tmp_path / "r.urdf"
+    path.write_text(_TWO_LINKS.format(doctype=doctype, pi=pi, xyz=xyz), encoding="ascii")
+    with pytest.raises(ValueError):
+        pin.buildModelFromXML(path.read_text())
+    expected = pin.buildModelFromXML(ET.tostring(read_urdf_xml(str(path)), encoding="unicode"))
+    assert expected.nq == 1 and np.isclose(expected.jointPlacements[1].translation[2], 0.333)
+    return path, expected
+
+
+@_REFUSED_AS_READ
+def test_xml_urdfdom_reads_otherwise_goes_to_pinocchio_re_serialised(tmp_path: Path, doctype, pi, xyz) -> None:
+    """A DOCTYPE, a processing instruction, a tab or line break inside an attribute: not the as-read
+    shortcut, the round trip every file took before it (the same model as then)."""
+    path, expected = _refused_as_read(tmp_path, doctype, pi, xyz)
+    km_module._XML_MEMO.clear()
+    xml, converted = _urdf_xml_without_continuous(str(path))
+    assert xml == ET.tostring(read_urdf_xml(str(path)), encoding="unicode") and converted == frozenset()
+    model, _ = km_module._full_model(str(path))
+    assert model.nq == 1
+    assert np.allclose(model.jointPlacements[1].translation, expected.jointPlacements[1].translation)
+
+
+@_REFUSED_AS_READ
+def test_a_text_pinocchio_refuses_as_read_is_built_from_the_round_trip(tmp_path: Path, monkeypatch, doctype, pi,
+                                                                       xyz) -> None:
+    """Whatever else urdfdom refuses as written (here: the screen above switched off) is built once
+    more from the round trip rather than failing."""
+    path, expected = _refused_as_read(tmp_path, doctype, pi, xyz)
+    monkeypatch.setattr(km_module, "_PLAIN_XML_ONLY_AFTER_ROUND_TRIP", re.compile(rb"(?!)"))
+    km_module._XML_MEMO.clear()
+    assert _urdf_xml_without_continuous(str(path))[0] == path.read_text()  # taken as read
+    model, converted = km_module._full_model(str(path))
+    km_module._XML_MEMO.clear()
+    assert converted == frozenset() and model.nq == 1
+    assert np.allclose(model.jointPlacements[1].translation, expected.jointPlacements[1].translation)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -42,6 +43,10 @@ TCP_FRAME = "tcp"
 
 
 _XML_MEMO: dict[tuple[str, int, int], tuple[str, frozenset[str]]] = {}
+# What urdfdom (pinocchio's parser) refuses or reads otherwise, and ElementTree's round trip writes
+# plainly: a DOCTYPE (internal entities), a processing instruction after the XML declaration, a tab
+# or line break inside an attribute value. Such a file is handed over re-serialised, as all were once.
+_PLAIN_XML_ONLY_AFTER_ROUND_TRIP = re.compile(rb"<!DOCTYPE|(?<!^)<\?|=\s*\"[^\"]*[\t\r\n][^\"]*\"|=\s*'[^']*[\t\r\n][^']*'")
 
 
 def _urdf_xml_without_continuous(path: str) -> tuple[str, frozenset[str]]:
@@ -51,8 +56,9 @@ def _urdf_xml_without_continuous(path: str) -> tuple[str, frozenset[str]]:
     the interface simple. Returns (xml text, names of the converted joints); remembered per file
     (path, size, mtime): a process builds several models of one robot before its first episode.
 
-    A file that cannot hold a continuous joint (the word ``continuous`` nowhere in it) and is plain
-    ASCII (no encoding or byte-order mark to interpret) is returned as read: nothing to convert, and
+    A file that cannot hold a continuous joint (the word ``continuous`` nowhere in it), is plain
+    ASCII (no encoding or byte-order mark to interpret) and holds none of the XML that urdfdom reads
+    otherwise than ElementTree (``_PLAIN_XML_ONLY_AFTER_ROUND_TRIP``) is returned as read: nothing to convert, and
     pinocchio builds the same model from it as from the parsed and re-serialised tree (compared for
     every shipped robot in ``tests/test_kinematics_model_memo.py``), without the ≈ 2 ms round trip.
     """
@@ -64,15 +70,37 @@ def _urdf_xml_without_continuous(path: str) -> tuple[str, frozenset[str]]:
         if len(_XML_MEMO) >= 16:
             _XML_MEMO.pop(next(iter(_XML_MEMO)))
         data = Path(path).read_bytes()
-        if b"continuous" not in data and data.isascii():
+        if b"continuous" not in data and data.isascii() and not _PLAIN_XML_ONLY_AFTER_ROUND_TRIP.search(data):
             _XML_MEMO[key] = (data.decode("ascii"), frozenset())
         else:
-            from robocfg.assets.urdf_xml import read_urdf_xml, revolute_continuous
-
-            root = read_urdf_xml(path)
-            converted = revolute_continuous(root, math.pi)
-            _XML_MEMO[key] = (ET.tostring(root, encoding="unicode"), frozenset(converted))
+            _XML_MEMO[key] = _reserialised_xml(path)
     return _XML_MEMO[key]
+
+
+def _reserialised_xml(path: str) -> tuple[str, frozenset[str]]:
+    """The URDF parsed by ElementTree, its continuous joints made revolute, serialised again."""
+    from robocfg.assets.urdf_xml import read_urdf_xml, revolute_continuous
+
+    root = read_urdf_xml(path)
+    converted = revolute_continuous(root, math.pi)
+    return ET.tostring(root, encoding="unicode"), frozenset(converted)
+
+
+def _full_model(path: str) -> tuple[pin.Model, frozenset[str]]:
+    """pinocchio's model of the whole URDF and the names of its joints made revolute.
+
+    urdfdom (pinocchio's parser) refuses some XML that ElementTree reads and writes back plainly:
+    a DOCTYPE with internal entities, a processing instruction inside the document, a tab or line
+    break inside a number. A text taken as read that pinocchio refuses is therefore built once more
+    from the re-serialised tree, as every file was before the as-read shortcut."""
+    xml, continuous = _urdf_xml_without_continuous(path)
+    try:
+        return pin.buildModelFromXML(xml), continuous
+    except ValueError:
+        xml2, continuous2 = _reserialised_xml(path)
+        if xml2 == xml:
+            raise
+        return pin.buildModelFromXML(xml2), continuous2
 
 
 @dataclass
@@ -165,8 +193,7 @@ class KinematicModel:
         """The model :meth:`from_robot` describes, built from the URDF."""
         cfg = robot.config
         arm_cfg = cfg.arm(arm)
-        xml, continuous = _urdf_xml_without_continuous(str(robot.urdf_path))
-        full = pin.buildModelFromXML(xml)
+        full, continuous = _full_model(str(robot.urdf_path))
         arm_joints = robot.arm_joints(arm_cfg)
 
         locked = locked_joint_values(robot, arm_cfg.name, gripper_q or {})
